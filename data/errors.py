@@ -1,0 +1,46 @@
+"""Exceptions raised by the ALFA data layer.
+
+Every message names the flight, and where they apply the file, the column and the
+line, so that a broken input can be found without a debugger.
+"""
+
+from __future__ import annotations
+
+__all__ = ["AlfaDataError", "MissingTopicError"]
+
+
+class AlfaDataError(ValueError):
+    """Input that cannot be read without risking a wrong number.
+
+    Parameters
+    ----------
+    message : str
+        What is wrong.
+    flight, file, column : str, optional
+        Where it is wrong.
+    line : int, optional
+        1-based line number in ``file`` (the header is line 1).
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        flight: str | None = None,
+        file: str | None = None,
+        column: str | None = None,
+        line: int | None = None,
+    ):
+        self.flight, self.file, self.column, self.line = flight, file, column, line
+        where = [f"flight {flight}"] if flight else []
+        if file:
+            where.append(f"file {file}")
+        if column:
+            where.append(f"column {column!r}")
+        if line is not None:
+            where.append(f"line {line}")
+        super().__init__(f"{', '.join(where)}: {message}" if where else message)
+
+
+class MissingTopicError(AlfaDataError):
+    """A topic a method needs has no CSV file in the flight folder."""

@@ -1,0 +1,367 @@
+"""Read one ALFA flight folder into a typed, validated object.
+
+A processed ALFA flight is a folder ``<flight>/`` holding one CSV per ROS topic,
+``<flight>-<topic>.csv``, as exported by ``rostopic echo -p``: the first column
+``%time`` is the record time in ns (UTC epoch), the others are ``field.*``.
+Ground truth is the ``failure_status-*`` topics, whose rows exist only while a
+fault is active.
+
+All times of a flight are put on one clock, seconds from the flight's first
+sample (the earliest ``%time`` of any topic).
+
+Bad input policy (also in the README):
+
+- raised as :class:`AlfaDataError`, naming flight, file, column and line: an empty
+  file, a header without rows, a row with the wrong number of fields, a
+  ``%time`` that is not an integer, timestamps that go backwards, a
+  non-numeric, NaN or infinite cell in a column that is used, a
+  ``failure_status`` topic without rows, a ground-truth topic that is not one of
+  ALFA's four, a ``no_failure`` flight with ground truth rows;
+- repaired and logged (warning on the ``alfa_bench.data`` logger, and kept in
+  :attr:`Flight.repairs` so that results record it): a last line cut short
+  (no final newline, as left by an interrupted copy) is dropped; rows that repeat
+  the previous row's ``%time`` are dropped, keeping the last, since ROS
+  re-publishes a message rather than sampling twice in one nanosecond.
+"""
+
+from __future__ import annotations
+
+import io
+import logging
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .errors import AlfaDataError, MissingTopicError
+
+__all__ = [
+    "FAULT_CLASSES",
+    "Fault",
+    "Flight",
+    "Topic",
+    "find_flights",
+    "load_flight",
+    "parse_flight_name",
+]
+
+log = logging.getLogger("alfa_bench.data")
+
+FAULT_CLASSES = ("engine", "rudder", "elevator", "aileron", "rudder+aileron", "none")
+
+#: ground-truth topic -> fault class, in the order used to name combined faults
+_GROUND_TRUTH_TOPICS = {
+    "failure_status-engines": "engine",
+    "failure_status-elevator": "elevator",
+    "failure_status-rudder": "rudder",
+    "failure_status-aileron": "aileron",
+}
+
+_FLIGHT_NAME = re.compile(
+    r"^carbonZ_(?P<date>\d{4}-\d{2}-\d{2})-(?P<time>\d{2}-\d{2}-\d{2})"
+    r"(?:_(?P<part>\d+))?_(?P<label>[A-Za-z0-9_]+)$"
+)
+
+
+def parse_flight_name(name: str) -> dict[str, str | int | None]:
+    """Split an ALFA flight folder name into date, time, part and fault label.
+
+    >>> parse_flight_name("carbonZ_2018-07-18-15-53-31_1_engine_failure")["label"]
+    'engine_failure'
+    """
+    m = _FLIGHT_NAME.match(name)
+    if m is None:
+        raise AlfaDataError(
+            "folder name is not an ALFA flight name "
+            "(carbonZ_YYYY-MM-DD-hh-mm-ss[_N]_<label>)",
+            flight=name,
+        )
+    part = m["part"]
+    return {
+        "date": m["date"],
+        "time": m["time"],
+        "part": int(part) if part else None,
+        "label": m["label"],
+    }
+
+
+@dataclass(frozen=True, eq=False)
+class Topic:
+    """One topic of a flight: its sample times and raw columns.
+
+    Attributes
+    ----------
+    name : str
+        Topic name as in the file name, e.g. ``mavros-nav_info-roll``.
+    file : str
+        File name, for messages.
+    t : ndarray of float64
+        Record times in seconds on the flight clock, strictly increasing.
+    frame : DataFrame
+        The ``field.*`` columns as read; use :meth:`values` for numbers.
+    lines : ndarray of int
+        1-based line of each row in the file, for messages.
+    """
+
+    flight: str
+    name: str
+    file: str
+    t: np.ndarray
+    frame: pd.DataFrame
+    lines: np.ndarray
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    def values(self, column: str) -> np.ndarray:
+        """Return ``column`` as float64, checked to be finite in every row."""
+        if column in self._cache:
+            return self._cache[column]
+        if column not in self.frame.columns:
+            raise AlfaDataError("no such column", flight=self.flight, file=self.file,
+                                column=column)
+        raw = self.frame[column]
+        v = pd.to_numeric(raw, errors="coerce").to_numpy(dtype=np.float64)
+        bad = ~np.isfinite(v)
+        if bad.any():
+            i = int(np.argmax(bad))
+            cell = raw.iloc[i]
+            if isinstance(cell, str):
+                what = f"non-numeric cell {cell!r}"
+            elif np.isnan(v[i]):
+                what = "empty or NaN cell"
+            else:
+                what = f"infinite value {v[i]}"
+            raise AlfaDataError(f"{what} ({int(bad.sum())} bad cells in all)",
+                                flight=self.flight, file=self.file, column=column,
+                                line=int(self.lines[i]))
+        v.setflags(write=False)
+        self._cache[column] = v
+        return v
+
+
+@dataclass(frozen=True)
+class Fault:
+    """Ground truth of a flight.
+
+    Attributes
+    ----------
+    fault_class : str
+        One of :data:`FAULT_CLASSES`.
+    onset_s, end_s : float or None
+        First and last ground-truth row on the flight clock (None without fault).
+        The onset is known only to the ground-truth topic's period
+        (0.2 s in July 2018, 0.5 s later).
+    topics : tuple of str
+        The ``failure_status-*`` topics present.
+    codes : dict
+        Topic -> distinct ``field.data`` codes in order of appearance.
+    """
+
+    fault_class: str
+    onset_s: float | None = None
+    end_s: float | None = None
+    topics: tuple[str, ...] = ()
+    codes: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Flight:
+    """A loaded ALFA flight.
+
+    Attributes
+    ----------
+    id : str
+        Folder name.
+    date, label : str
+        From the folder name; ``label`` is the raw fault label.
+    emergency_trajectory : bool
+        The label ends in ``with_emr_traj``: the commands change at the fault.
+    t0_ns : int
+        Epoch time of the flight clock's zero.
+    duration_s : float
+        Last sample of any topic on the flight clock.
+    fault : Fault or None
+        None when the flight has no ground truth.
+    topics : dict
+        Topic name -> :class:`Topic`.
+    repairs : tuple of str
+        Repairs made while reading, also logged.
+    """
+
+    id: str
+    path: Path
+    date: str
+    label: str
+    emergency_trajectory: bool
+    t0_ns: int
+    duration_s: float
+    fault: Fault | None
+    topics: dict
+    repairs: tuple[str, ...] = ()
+
+    @property
+    def has_ground_truth(self) -> bool:
+        return self.fault is not None
+
+    def topic(self, name: str) -> Topic:
+        """Return topic ``name``, or raise :class:`MissingTopicError`."""
+        try:
+            return self.topics[name]
+        except KeyError:
+            raise MissingTopicError("topic file is missing", flight=self.id,
+                                    file=f"{self.id}-{name}.csv") from None
+
+
+def find_flights(processed: Path) -> list[Path]:
+    """Flight folders under ``processed``, sorted by name.
+
+    A sub-folder without any ``<folder>-*.csv`` file is not a flight: it is
+    skipped with a warning.
+    """
+    processed = Path(processed)
+    if not processed.is_dir():
+        raise AlfaDataError(f"no such folder: {processed}")
+    flights = []
+    for d in sorted(p for p in processed.iterdir() if p.is_dir()):
+        if any(d.glob(f"{_glob_escape(d.name)}-*.csv")):
+            flights.append(d)
+        else:
+            log.warning("skipped %s: not a flight folder (no %s-*.csv files)", d, d.name)
+    return flights
+
+
+def _glob_escape(s: str) -> str:
+    return re.sub(r"([*?\[])", r"[\1]", s)
+
+
+def load_flight(path: str | Path) -> Flight:
+    """Read and validate the flight folder at ``path``.
+
+    Raises
+    ------
+    AlfaDataError
+        For any input that cannot be read safely; see the module docstring.
+    """
+    path = Path(path)
+    name = path.name
+    meta = parse_flight_name(name)
+    prefix = f"{name}-"
+    raw: dict[str, tuple] = {}
+    repairs: list[str] = []
+    for f in sorted(path.glob(f"{_glob_escape(name)}-*.csv")):
+        topic = f.name[len(prefix):-len(".csv")]
+        t_ns, frame, lines = _read_topic(f, name, repairs)
+        raw[topic] = (f.name, t_ns, frame, lines)
+    if not raw:
+        raise AlfaDataError("no topic files (<flight>-<topic>.csv)", flight=name)
+
+    t0 = min(int(v[1][0]) for v in raw.values())
+    topics = {
+        topic: Topic(name, topic, file, (t_ns - t0) * 1e-9, frame, lines)
+        for topic, (file, t_ns, frame, lines) in raw.items()
+    }
+    duration = max(float(tp.t[-1]) for tp in topics.values())
+    label = str(meta["label"])
+    return Flight(
+        id=name,
+        path=path,
+        date=str(meta["date"]),
+        label=label,
+        emergency_trajectory=label.endswith("with_emr_traj"),
+        t0_ns=t0,
+        duration_s=duration,
+        fault=_ground_truth(name, label, topics),
+        topics=topics,
+        repairs=tuple(repairs),
+    )
+
+
+def _ground_truth(flight: str, label: str, topics: dict[str, Topic]) -> Fault | None:
+    gt = sorted(t for t in topics if t.startswith("failure_status"))
+    unknown = [t for t in gt if t not in _GROUND_TRUTH_TOPICS]
+    if unknown:
+        raise AlfaDataError(f"unknown ground-truth topic (known: "
+                            f"{', '.join(_GROUND_TRUTH_TOPICS)})",
+                            flight=flight, file=f"{flight}-{unknown[0]}.csv")
+    if not gt:
+        if label == "no_failure":
+            return Fault("none")
+        log.warning("flight %s: label %r names no ground truth and no failure_status "
+                    "topic exists: it is kept out of labelled scoring", flight, label)
+        return None
+    if label == "no_failure":
+        raise AlfaDataError("labelled no_failure but has ground-truth rows",
+                            flight=flight, file=f"{flight}-{gt[0]}.csv")
+    order = list(_GROUND_TRUTH_TOPICS)
+    gt.sort(key=order.index)
+    codes = {t: tuple(dict.fromkeys(topics[t].values("field.data").astype(int).tolist()))
+             for t in gt}
+    return Fault(
+        fault_class="+".join(_GROUND_TRUTH_TOPICS[t] for t in gt),
+        onset_s=min(float(topics[t].t[0]) for t in gt),
+        end_s=max(float(topics[t].t[-1]) for t in gt),
+        topics=tuple(gt),
+        codes=codes,
+    )
+
+
+def _read_topic(path: Path, flight: str, repairs: list[str]):
+    """Parse one topic CSV; returns (%time in ns, field frame, line numbers)."""
+    file = path.name
+
+    def fail(msg, **where):
+        return AlfaDataError(msg, flight=flight, file=file, **where)
+
+    data = path.read_bytes()
+    if not data:
+        raise fail("empty file (0 bytes)")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise fail(f"not UTF-8 text ({e.reason} at byte {e.start})") from None
+    lines = text.split("\n")
+    complete = text.endswith("\n")
+    if complete:
+        lines.pop()
+    if len(lines) == 1 and not complete:
+        raise fail("file ends inside the header line (truncated)", line=1)
+    header = lines[0].split(",")
+    if header[0] != "%time":
+        raise fail("header must start with %time", line=1)
+    if not complete:
+        lines.pop()
+        repairs.append(f"{file}: dropped truncated last line {len(lines) + 1} "
+                       "(file does not end with a newline)")
+        log.warning("flight %s: %s", flight, repairs[-1])
+    if len(lines) == 1:
+        raise fail("header only, no data rows")
+    commas = len(header) - 1
+    for i, line in enumerate(lines[1:], start=2):
+        if line.count(",") != commas:
+            raise fail(f"row has {line.count(',') + 1} fields, header has {len(header)}",
+                       line=i)
+
+    frame = pd.read_csv(io.StringIO("\n".join(lines)), dtype={"%time": str},
+                        keep_default_na=True)
+    line_no = np.arange(2, len(frame) + 2)
+    t_text = frame.pop("%time")
+    bad = ~t_text.str.fullmatch(r"\d{1,19}").fillna(False).to_numpy()
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise fail(f"%time {t_text.iloc[i]!r} is not an integer number of ns",
+                   column="%time", line=int(line_no[i]))
+    t_ns = t_text.astype(np.int64).to_numpy()
+
+    step = np.diff(t_ns)
+    if (step < 0).any():
+        i = int(np.argmax(step < 0))
+        raise fail(f"timestamps go backwards ({t_ns[i + 1]} after {t_ns[i]})",
+                   column="%time", line=int(line_no[i + 1]))
+    if (step == 0).any():
+        keep = np.r_[step != 0, True]
+        repairs.append(f"{file}: dropped {int((~keep).sum())} rows repeating the previous "
+                       "row's %time (kept the last of each run)")
+        log.warning("flight %s: %s", flight, repairs[-1])
+        t_ns, frame, line_no = t_ns[keep], frame[keep].reset_index(drop=True), line_no[keep]
+    return t_ns, frame, line_no

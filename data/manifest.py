@@ -1,0 +1,136 @@
+"""The flight manifest: one row per flight found, with its ground truth and subsets.
+
+Subsets (a flight may be in several):
+
+``all``
+    every flight with ground truth (a labelled fault, or ``no_failure``);
+``icra22``
+    the 22 flights of Keipour et al., ICRA 2019: recorded up to 2018-09-11
+    inclusive, with ground truth, not ``with_emr_traj``;
+``no_emr`` / ``emr``
+    flights with ground truth without / with the emergency trajectory, whose
+    commands change at the fault (reported apart, as the ALFA notes advise).
+
+Nothing here lists flights by name: the subsets are rules over what is found.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from importlib import resources
+from pathlib import Path
+
+import jsonschema
+import pandas as pd
+
+from .errors import AlfaDataError
+from .flight import Flight, find_flights, load_flight, parse_flight_name
+
+__all__ = ["ICRA22_LAST_DATE", "SUBSETS", "build_manifest", "flight_sha256", "manifest_row",
+           "read_manifest", "subset_flights", "validate_manifest"]
+
+ICRA22_LAST_DATE = "2018-09-11"
+
+SUBSETS = {
+    "all": lambda r: r["ground_truth"],
+    "icra22": lambda r: (r["ground_truth"] and r["date"] <= ICRA22_LAST_DATE
+                         and not r["emergency_trajectory"]),
+    "no_emr": lambda r: r["ground_truth"] and not r["emergency_trajectory"],
+    "emr": lambda r: r["ground_truth"] and r["emergency_trajectory"],
+}
+
+COLUMNS = ["flight", "date", "time", "label", "fault_class", "ground_truth",
+           "emergency_trajectory", "onset_s", "fault_end_s", "fault_s", "flight_s",
+           "pre_fault_s", "n_topics", "repairs", "sha256", "subsets"]
+
+
+def _schema() -> dict:
+    return json.loads(resources.files(__package__).joinpath("manifest.schema.json").read_text())
+
+
+def flight_sha256(path: Path) -> str:
+    """SHA-256 over the flight's files, each as ``name\\0content``, sorted by name."""
+    h = hashlib.sha256()
+    for f in sorted(Path(path).glob("*.csv")):
+        h.update(f.name.encode() + b"\0")
+        h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+def manifest_row(flight: Flight) -> dict:
+    """The manifest row of a loaded flight."""
+    fault = flight.fault
+    onset = fault.onset_s if fault else None
+    if fault is None:
+        pre = None
+    elif onset is None:
+        pre = flight.duration_s
+    else:
+        pre = onset
+    row = {
+        "flight": flight.id,
+        "date": flight.date,
+        "time": parse_flight_name(flight.id)["time"],
+        "label": flight.label,
+        "fault_class": fault.fault_class if fault else "unknown",
+        "ground_truth": fault is not None,
+        "emergency_trajectory": flight.emergency_trajectory,
+        "onset_s": onset,
+        "fault_end_s": fault.end_s if fault else None,
+        "fault_s": (fault.end_s - onset) if onset is not None else None,
+        "flight_s": flight.duration_s,
+        "pre_fault_s": pre,
+        "n_topics": len(flight.topics),
+        "repairs": len(flight.repairs),
+        "sha256": flight_sha256(flight.path),
+    }
+    row["subsets"] = ";".join(name for name, rule in SUBSETS.items() if rule(row))
+    return row
+
+
+def build_manifest(processed: str | Path) -> pd.DataFrame:
+    """Load every flight under ``processed`` and return the validated manifest."""
+    rows = [manifest_row(load_flight(p)) for p in find_flights(Path(processed))]
+    if not rows:
+        raise AlfaDataError(f"no flights found under {processed}")
+    manifest = pd.DataFrame(rows, columns=COLUMNS)
+    validate_manifest(manifest)
+    return manifest
+
+
+def validate_manifest(manifest: pd.DataFrame) -> None:
+    """Check every row against ``manifest.schema.json``; raise AlfaDataError if not."""
+    schema = _schema()
+    validator = jsonschema.Draft202012Validator(schema)
+    for record in manifest.to_dict(orient="records"):
+        clean = {k: (None if isinstance(v, float) and math.isnan(v) else v)
+                 for k, v in record.items()}
+        errors = sorted(validator.iter_errors(clean), key=lambda e: list(e.path))
+        if errors:
+            e = errors[0]
+            raise AlfaDataError(f"manifest row does not match the schema: {e.message}",
+                                flight=str(record.get("flight")),
+                                column=".".join(map(str, e.path)) or None)
+    if manifest["flight"].duplicated().any():
+        raise AlfaDataError("manifest lists a flight twice: "
+                            f"{manifest.loc[manifest['flight'].duplicated(), 'flight'].iloc[0]}")
+
+
+def read_manifest(path: str | Path) -> pd.DataFrame:
+    """Read ``data/flights.csv`` back with its types, and validate it."""
+    manifest = pd.read_csv(path, dtype={"date": str, "time": str, "subsets": str},
+                           keep_default_na=False, na_values={c: [""] for c in
+                           ("onset_s", "fault_end_s", "fault_s", "pre_fault_s")})
+    manifest["subsets"] = manifest["subsets"].fillna("")
+    validate_manifest(manifest)
+    return manifest
+
+
+def subset_flights(manifest: pd.DataFrame, subset: str) -> list[str]:
+    """Flights of ``subset``, in manifest order."""
+    if subset not in SUBSETS:
+        raise KeyError(f"unknown subset {subset!r}; known: {sorted(SUBSETS)}")
+    member = manifest["subsets"].str.split(";").apply(lambda s: subset in s)
+    return manifest.loc[member, "flight"].tolist()

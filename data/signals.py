@@ -1,0 +1,109 @@
+"""Named flight signals and their causal sampling on a fixed-rate grid.
+
+Detectors ask for signals by name (``roll_cmd``, ``roll_error``, ...) and a rate;
+:func:`sample` returns them on the grid :math:`t_k = k / f_s` of the flight clock.
+
+Sampling is a causal zero-order hold: the value at :math:`t_k` is that of the
+latest row with record time :math:`\\le t_k`. Nothing after :math:`t_k` is used,
+so no interpolation; the grid covers only the span where every requested topic
+has started and none has ended.
+
+ALFA topics are sample-and-hold streams (``nav_info`` roll and pitch rows come at
+~19.5 Hz, but the measured value changes at ~2.5 Hz). :func:`sample` therefore
+also returns, per signal, whether each grid value is *fresh*: it comes from a row
+whose measured field changed since the previous grid point.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import AlfaDataError
+from .flight import Flight
+
+__all__ = ["SIGNALS", "Sampled", "Signal", "sample"]
+
+
+@dataclass(frozen=True)
+class Signal:
+    """A column of a topic, optionally minus another column of the same rows.
+
+    Freshness follows ``column`` (the measured quantity).
+    """
+
+    topic: str
+    column: str
+    minus: str | None = None
+    unit: str = ""
+
+
+def _attitude(axis: str) -> dict[str, Signal]:
+    topic = f"mavros-nav_info-{axis}"
+    return {
+        f"{axis}_cmd": Signal(topic, "field.commanded", unit="deg"),
+        axis: Signal(topic, "field.measured", unit="deg"),
+        f"{axis}_error": Signal(topic, "field.measured", minus="field.commanded", unit="deg"),
+    }
+
+
+#: The catalogue of named signals.
+SIGNALS: dict[str, Signal] = {
+    **_attitude("roll"),
+    **_attitude("pitch"),
+    **_attitude("yaw"),
+    "airspeed_cmd": Signal("mavros-nav_info-airspeed", "field.commanded", unit="m/s"),
+    "airspeed": Signal("mavros-nav_info-airspeed", "field.measured", unit="m/s"),
+}
+
+
+@dataclass(frozen=True)
+class Sampled:
+    """Signals on a fixed grid.
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,)
+        Grid times on the flight clock, s.
+    x : ndarray, shape (n, m)
+        Held values of the m signals, in the order requested.
+    fresh : ndarray of bool, shape (n, m)
+        True where the value comes from a new measurement.
+    names : tuple of str
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    fresh: np.ndarray
+    names: tuple[str, ...]
+
+
+def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float) -> Sampled:
+    """Sample the named signals of ``flight`` at ``rate_hz`` (causal hold)."""
+    names = tuple(names)
+    unknown = [n for n in names if n not in SIGNALS]
+    if unknown:
+        raise AlfaDataError(f"unknown signal(s) {unknown}; known: {sorted(SIGNALS)}",
+                            flight=flight.id)
+    topics = [flight.topic(SIGNALS[n].topic) for n in names]
+    start = max(float(tp.t[0]) for tp in topics)
+    stop = min(float(tp.t[-1]) for tp in topics)
+    k = np.arange(np.ceil(start * rate_hz), np.floor(stop * rate_hz) + 1)
+    t = k / rate_hz
+    if t.size == 0:
+        raise AlfaDataError(f"signals {list(names)} never overlap in time", flight=flight.id)
+
+    x = np.empty((t.size, len(names)))
+    fresh = np.empty((t.size, len(names)), dtype=bool)
+    for j, (name, tp) in enumerate(zip(names, topics, strict=True)):
+        sig = SIGNALS[name]
+        row = np.searchsorted(tp.t, t, side="right") - 1
+        measured = tp.values(sig.column)
+        value = measured - tp.values(sig.minus) if sig.minus else measured
+        x[:, j] = value[row]
+        changed = np.r_[True, measured[1:] != measured[:-1]]
+        last_change = np.maximum.accumulate(np.where(changed, np.arange(measured.size), 0))
+        source = last_change[row]
+        fresh[:, j] = np.r_[True, source[1:] != source[:-1]]
+    return Sampled(t=t, x=x, fresh=fresh, names=names)

@@ -1,0 +1,41 @@
+import os
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).parent))
+
+from synthetic import write_corpus, write_flight  # noqa: E402
+
+REAL_ALFA = Path(os.environ["ALFA_DIR"]) if os.environ.get("ALFA_DIR") else None
+
+
+def pytest_report_header(config):
+    if REAL_ALFA and (REAL_ALFA / "processed").is_dir():
+        return f"ALFA_DIR={REAL_ALFA}: tests on the real flights will run"
+    return ("*** ALFA_DIR is not set or has no processed/: the tests on the real ALFA "
+            "flights are SKIPPED ***")
+
+
+@pytest.fixture(scope="session")
+def real_processed() -> Path:
+    if not (REAL_ALFA and (REAL_ALFA / "processed").is_dir()):
+        pytest.skip("real ALFA flights not available: set ALFA_DIR to the folder "
+                    "holding processed/")
+    return REAL_ALFA / "processed"
+
+
+@pytest.fixture(scope="session")
+def corpus(tmp_path_factory) -> Path:
+    """A small synthetic corpus; returns its processed/ folder (read-only use)."""
+    processed = tmp_path_factory.mktemp("alfa") / "processed"
+    write_corpus(processed)
+    return processed
+
+
+@pytest.fixture
+def one_flight(tmp_path) -> Path:
+    """A writable synthetic engine-failure flight folder."""
+    return write_flight(tmp_path / "processed", "carbonZ_2018-07-18-15-53-31_1_engine_failure",
+                        onset_s=50.0)

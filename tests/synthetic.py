@@ -1,0 +1,85 @@
+"""Small synthetic flights in ALFA's on-disk format, made by the tests themselves.
+
+Roll and pitch follow a known first-order ARX law from their commands; after the
+fault onset the law changes (the control surface stops answering), which is the
+kind of change the detectors are built to see.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+T0_NS = 1_536_000_000_000_000_000
+ATTITUDE_HEADER = ("%time,field.header.seq,field.header.stamp,field.header.frame_id,"
+                   "field.commanded,field.measured")
+
+
+def arx_response(u: np.ndarray, a: float, b: float, noise: np.ndarray) -> np.ndarray:
+    """y(k) = a y(k-1) + b u(k) + noise(k)."""
+    y = np.zeros_like(u)
+    for k in range(1, u.size):
+        y[k] = a * y[k - 1] + b * u[k] + noise[k]
+    return y
+
+
+def command(n: int, rate_hz: float, rng: np.random.Generator) -> np.ndarray:
+    """A persistently exciting command: sum of sines plus piecewise-constant steps."""
+    t = np.arange(n) / rate_hz
+    steps = np.repeat(rng.uniform(-15, 15, size=n // 40 + 1), 40)[:n]
+    return 10 * np.sin(0.5 * t) + 5 * np.sin(1.7 * t + 1) + steps
+
+
+def attitude_rows(t_ns, commanded, measured) -> list[str]:
+    seq = np.arange(t_ns.size) + 1000
+    return [f"{t},{s},{t - 150_000},NED,{c!r},{m!r}"
+            for t, s, c, m in zip(t_ns.tolist(), seq.tolist(), commanded.tolist(),
+                                  measured.tolist(), strict=True)]
+
+
+def write_csv(path: Path, header: str, rows: list[str]) -> None:
+    path.write_text("\n".join([header, *rows]) + "\n")
+
+
+def write_flight(processed: Path, name: str, *, duration_s: float = 80.0, rate_hz: float = 20.0,
+                 onset_s: float | None = None, fault_topic: str = "failure_status-engines",
+                 code: int = 1, gt_rate_hz: float = 2.0, seed: int = 0) -> Path:
+    """Write flight ``name`` under ``processed`` and return its folder.
+
+    ``onset_s`` None writes a fault-free flight (no failure_status file).
+    """
+    rng = np.random.default_rng(seed)
+    folder = processed / name
+    folder.mkdir(parents=True)
+    n = int(duration_s * rate_hz)
+    t_ns = T0_NS + np.round(np.arange(n) / rate_hz * 1e9).astype(np.int64) + 1_000_000
+    faulty = np.zeros(n, dtype=bool) if onset_s is None else np.arange(n) / rate_hz >= onset_s
+    for i, axis in enumerate(("roll", "pitch")):
+        u = command(n, rate_hz, rng) / (i + 1)
+        y = arx_response(u, 0.8, 0.2, rng.normal(0, 0.05, n))
+        y_fault = arx_response(u, 0.8, 0.0, rng.normal(0, 0.05, n)) + 8.0
+        measured = np.where(faulty, y_fault, y)
+        write_csv(folder / f"{name}-mavros-nav_info-{axis}.csv", ATTITUDE_HEADER,
+                  attitude_rows(t_ns + i * 3_000_000, u, measured))
+    if onset_s is not None:
+        gt_t = np.arange(onset_s, duration_s, 1 / gt_rate_hz)
+        gt_ns = T0_NS + 1_000_000 + np.round(gt_t * 1e9).astype(np.int64)
+        write_csv(folder / f"{name}-{fault_topic}.csv", "%time,field.data",
+                  [f"{t},{code}" for t in gt_ns.tolist()])
+    return folder
+
+
+def write_corpus(processed: Path) -> dict[str, Path]:
+    """A small corpus: fault flights of several classes, fault-free, emr, late."""
+    specs = {
+        "carbonZ_2018-07-18-15-53-31_1_engine_failure": dict(onset_s=50.0),
+        "carbonZ_2018-07-18-16-37-39_1_no_failure": dict(seed=1),
+        "carbonZ_2018-07-30-16-29-45_engine_failure_with_emr_traj": dict(onset_s=55.0, seed=2),
+        "carbonZ_2018-09-11-15-06-34_3_rudder_left_failure":
+            dict(onset_s=45.0, fault_topic="failure_status-rudder", code=2, seed=3),
+        "carbonZ_2018-10-05-14-37-22_2_right_aileron_failure":
+            dict(onset_s=52.0, fault_topic="failure_status-aileron", code=1, seed=4),
+        "carbonZ_2018-10-05-14-34-20_1_no_failure": dict(seed=5),
+    }
+    return {name: write_flight(processed, name, **kw) for name, kw in specs.items()}
