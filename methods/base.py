@@ -1,0 +1,107 @@
+"""The streaming detector contract and the causal batch runner.
+
+A detector is built from hyper-parameters only; :meth:`Detector.reset` creates its
+learned state (attributes ending in ``_``); :meth:`Detector.update` consumes one
+time step of the signals it asks for and returns, per score channel, the score and
+the alarm of that step. A flight alarms when any channel alarms.
+"""
+
+from __future__ import annotations
+
+import inspect
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+
+import numpy as np
+
+from alfa_bench.data import Flight, sample
+
+__all__ = ["Detector", "Trace", "run_detector"]
+
+
+class Detector(ABC):
+    """Base class of every registered detector.
+
+    Subclasses store their ``__init__`` arguments unchanged under the same names
+    and nothing else, so that :meth:`get_params` can report them.
+    """
+
+    #: grid rate of the samples :meth:`update` expects, Hz
+    rate_hz: float
+
+    def get_params(self) -> dict:
+        """Hyper-parameters by name, as passed to ``__init__``."""
+        names = [p for p in inspect.signature(type(self).__init__).parameters if p != "self"]
+        return {n: getattr(self, n) for n in names}
+
+    @abstractmethod
+    def signals(self) -> tuple[str, ...]:
+        """Names (see :data:`alfa_bench.data.SIGNALS`) of the input columns."""
+
+    @abstractmethod
+    def channels(self) -> tuple[str, ...]:
+        """Names of the score channels."""
+
+    @abstractmethod
+    def reset(self) -> Detector:
+        """Forget everything learned; return self."""
+
+    @abstractmethod
+    def update(self, x: np.ndarray, fresh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Consume one time step.
+
+        Parameters
+        ----------
+        x : ndarray, shape (m,)
+            Values of :meth:`signals` at this step.
+        fresh : ndarray of bool, shape (m,)
+            Whether each value is a new measurement (see :func:`alfa_bench.data.sample`).
+
+        Returns
+        -------
+        score : ndarray, shape (c,)
+            Per channel; NaN while the channel is not yet armed.
+        alarm : ndarray of bool, shape (c,)
+        """
+
+
+@dataclass(frozen=True)
+class Trace:
+    """A detector's output over a flight, one row per grid step."""
+
+    t: np.ndarray
+    score: np.ndarray
+    alarm: np.ndarray
+    channels: tuple[str, ...]
+
+    @property
+    def any_alarm(self) -> np.ndarray:
+        return self.alarm.any(axis=1)
+
+    def first_alarm_s(self, channel: int | None = None) -> float | None:
+        """Time of the first alarm of ``channel`` (of any channel if None)."""
+        a = self.any_alarm if channel is None else self.alarm[:, channel]
+        return float(self.t[np.argmax(a)]) if a.any() else None
+
+    def armed_s(self, channel: int) -> float | None:
+        """Time of the first finite score of ``channel``: when it began to judge."""
+        ok = np.isfinite(self.score[:, channel])
+        return float(self.t[np.argmax(ok)]) if ok.any() else None
+
+    def alarm_intervals(self) -> list[tuple[float, float]]:
+        """Maximal runs of grid steps with an alarm, as (first, last) times."""
+        a = self.any_alarm.astype(np.int8)
+        edges = np.flatnonzero(np.diff(np.r_[0, a, 0]))
+        return [(float(self.t[s]), float(self.t[e - 1])) for s, e in edges.reshape(-1, 2)]
+
+
+def run_detector(detector: Detector, flight: Flight) -> Trace:
+    """Run ``detector`` causally over ``flight``, from a fresh state."""
+    s = sample(flight, detector.signals(), detector.rate_hz)
+    detector.reset()
+    n, c = s.t.size, len(detector.channels())
+    score = np.empty((n, c))
+    alarm = np.empty((n, c), dtype=bool)
+    for k in range(n):
+        score[k], alarm[k] = detector.update(s.x[k], s.fresh[k])
+    return Trace(t=s.t, score=score, alarm=alarm, channels=detector.channels())

@@ -1,0 +1,78 @@
+r"""Recursive least squares, as in Keipour et al. (ICRA 2019), eqs. (4)-(7).
+
+For the linear regression :math:`y(k) = \phi^T(k)\theta + n(k)`:
+
+.. math::
+
+    \hat e(k) &= y(k) - \phi^T(k)\hat\theta(k-1)                          && (4)\\
+    L(k) &= \frac{C(k-1)\phi(k)}{\lambda + \phi^T(k)C(k-1)\phi(k)}        && (5)\\
+    \hat\theta(k) &= \hat\theta(k-1) + L(k)\hat e(k)                     && (6)\\
+    C(k) &= \left(C(k-1) - L(k)\phi^T(k)C(k-1)\right)/\lambda            && (7)
+
+with :math:`\hat\theta(0) = 0` and :math:`C(0) = p_0 I`. The paper's form is
+:math:`\lambda = 1`; :math:`\lambda < 1` is the exponential forgetting used by
+Hansen et al. With :math:`\lambda = 1` the estimate after :math:`k` steps is
+exactly the ridge solution
+:math:`(\Phi^T\Phi + I/p_0)^{-1}\Phi^T y`, which the tests use as reference.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["RecursiveLeastSquares"]
+
+
+class RecursiveLeastSquares:
+    """RLS estimator with optional forgetting factor.
+
+    Parameters
+    ----------
+    n_params : int
+        Length of the regressor :math:`\\phi`.
+    p0 : float
+        Initial covariance :math:`C(0) = p_0 I`; large means little trust in
+        :math:`\\hat\\theta(0) = 0`.
+    forgetting : float
+        :math:`\\lambda \\in (0, 1]`.
+
+    Attributes
+    ----------
+    theta_ : ndarray
+        :math:`\\hat\\theta(k)`.
+    cov_ : ndarray
+        :math:`C(k)`.
+    error_, gain_, step_ : float, ndarray, ndarray
+        :math:`\\hat e(k)`, :math:`L(k)` and :math:`L(k)\\hat e(k)` of the last update.
+    """
+
+    def __init__(self, n_params: int, p0: float = 1e6, forgetting: float = 1.0):
+        self.n_params = n_params
+        self.p0 = p0
+        self.forgetting = forgetting
+
+    def reset(self) -> RecursiveLeastSquares:
+        if not 0.0 < self.forgetting <= 1.0:
+            raise ValueError(f"forgetting must be in (0, 1], got {self.forgetting}")
+        self.theta_ = np.zeros(self.n_params)
+        self.cov_ = np.eye(self.n_params) * self.p0
+        self.error_ = np.nan
+        self.gain_ = np.zeros(self.n_params)
+        self.step_ = np.zeros(self.n_params)
+        return self
+
+    def predict(self, phi: np.ndarray) -> float:
+        return float(phi @ self.theta_)
+
+    def update(self, phi: np.ndarray, y: float) -> float:
+        """One RLS step; returns the a-priori error :math:`\\hat e(k)`."""
+        lam = self.forgetting
+        e = y - phi @ self.theta_                      # (4) e = y - phi' theta
+        c_phi = self.cov_ @ phi
+        gain = c_phi / (lam + phi @ c_phi)             # (5) L = C phi / (lam + phi' C phi)
+        step = gain * e
+        self.theta_ = self.theta_ + step               # (6) theta += L e
+        cov = (self.cov_ - np.outer(gain, c_phi)) / lam  # (7) C = (C - L phi' C) / lam
+        self.cov_ = 0.5 * (cov + cov.T)                # keep C symmetric against round-off
+        self.error_, self.gain_, self.step_ = float(e), gain, step
+        return self.error_

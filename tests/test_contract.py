@@ -1,0 +1,88 @@
+"""The streaming contract, checked for every registered detector and configured run.
+
+A new method is picked up here by its registry line alone.
+"""
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from alfa_bench.data import load_flight
+from alfa_bench.methods import REGISTRY, make_detector, run_detector
+
+CONFIG = yaml.safe_load((Path(__file__).parent.parent / "config/config.yaml").read_text())
+RUNS = {name: (spec["detector"], spec.get("params", {})) for name, spec in
+        CONFIG["methods"].items()}
+CASES = {**{f"registry:{n}": (n, {}) for n in REGISTRY}, **{f"config:{n}": r for n, r in
+                                                           RUNS.items()}}
+
+
+@pytest.fixture(params=sorted(CASES))
+def detector(request):
+    name, params = CASES[request.param]
+    return make_detector(name, params)
+
+
+def assert_same(a, b, upto=None):
+    sl = slice(None) if upto is None else slice(0, upto)
+    np.testing.assert_array_equal(a.t[sl], b.t[sl])
+    np.testing.assert_array_equal(a.score[sl], b.score[sl])  # NaN == NaN here
+    np.testing.assert_array_equal(a.alarm[sl], b.alarm[sl])
+
+
+def test_constructor_stores_hyper_parameters_only(detector):
+    assert set(vars(detector)) == set(detector.get_params())
+    before = set(vars(detector))
+    detector.reset()
+    learned = set(vars(detector)) - before
+    assert learned and all(a.endswith("_") for a in learned)
+
+
+def test_outputs_have_the_declared_shape(detector, one_flight):
+    trace = run_detector(detector, load_flight(one_flight))
+    assert trace.score.shape == trace.alarm.shape == (trace.t.size, len(detector.channels()))
+    assert trace.alarm.dtype == bool
+    assert np.all(np.diff(trace.t) > 0)
+
+
+def test_deterministic(detector, one_flight):
+    flight = load_flight(one_flight)
+    assert_same(run_detector(detector, flight), run_detector(detector, flight))
+
+
+def test_reset_forgets_the_previous_flight(detector, corpus, one_flight):
+    other = load_flight(next(p for p in corpus.iterdir() if "no_failure" in p.name))
+    flight = load_flight(one_flight)
+    run_detector(detector, other)
+    fresh = type(detector)(**detector.get_params())
+    assert_same(run_detector(detector, flight), run_detector(fresh, flight))
+
+
+def test_causal(detector, one_flight, tmp_path):
+    """Changing the data after time t changes no output before t."""
+    flight = load_flight(one_flight)
+    base = run_detector(detector, flight)
+    cut_s = 0.7 * float(base.t[-1])
+    altered = shutil.copytree(one_flight, tmp_path / "altered" / one_flight.name)
+    for f in altered.glob("*nav_info*.csv"):
+        lines = f.read_text().splitlines()
+        t_ns = np.array([int(line.split(",", 1)[0]) for line in lines[1:]])
+        cut_ns = flight.t0_ns + int(cut_s * 1e9)
+        out = [lines[0]]
+        for line, t in zip(lines[1:], t_ns, strict=True):
+            if t > cut_ns:  # scramble everything after the cut
+                cells = line.split(",")
+                cells[-1] = repr(float(cells[-1]) * -3.0 + 17.0)
+                cells[-2] = repr(float(cells[-2]) + 40.0)
+                line = ",".join(cells)
+            out.append(line)
+        f.write_text("\n".join(out) + "\n")
+    changed = run_detector(detector, load_flight(altered))
+    before = int(np.searchsorted(base.t, cut_s, side="right"))
+    assert before > 0
+    assert_same(base, changed, upto=before)
+    # the alteration must reach the detector, or this test could not fail
+    assert not np.array_equal(base.score[before:], changed.score[before:], equal_nan=True)
