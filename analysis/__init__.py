@@ -1,0 +1,9 @@
+"""Scoring, tables and provenance of detector runs."""
+
+from .detections import detection_record, read_records, write_record
+from .scoring import OUTCOMES, flight_outcome, summarize
+from .tables import by_fault_markdown, by_fault_table, summary_markdown, summary_table
+
+__all__ = ["OUTCOMES", "by_fault_markdown", "by_fault_table", "detection_record",
+           "flight_outcome", "read_records", "summarize", "summary_markdown",
+           "summary_table", "write_record"]

@@ -1,0 +1,129 @@
+"""Summary and per-fault-class tables, as CSV and Markdown.
+
+``summary``: one row per (method, subset) with the scoring of
+:func:`~.scoring.summarize`. ``by_fault``: the layout of Keipour et al.'s
+Table I per method and subset: fault class, flights, flight time, mean and max
+detection time, accuracy, and a total row.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pandas as pd
+
+from alfa_bench.data import subset_flights
+
+from .reference import ICRA2019_BY_FAULT, ICRA2019_NAME, ICRA2019_SUMMARY
+from .scoring import summarize
+
+__all__ = ["by_fault_markdown", "by_fault_table", "summary_markdown", "summary_table"]
+
+FAULT_ORDER = ("engine", "rudder", "elevator", "aileron", "rudder+aileron", "none")
+
+
+def _records_for(records: list[dict], manifest: pd.DataFrame, subset: str) -> dict:
+    """method -> records of the subset's flights; every flight must have one."""
+    flights = subset_flights(manifest, subset)
+    by_method: dict[str, dict[str, dict]] = {}
+    for r in records:
+        by_method.setdefault(r["method"], {})[r["flight"]] = r
+    out = {}
+    for method, recs in by_method.items():
+        missing = [f for f in flights if f not in recs]
+        if missing:
+            raise ValueError(f"method {method}: no detection for {len(missing)} flight(s) of "
+                             f"subset {subset}, e.g. {missing[0]}")
+        out[method] = [recs[f] for f in flights]
+    return out
+
+
+def summary_table(records: list[dict], manifest: pd.DataFrame, subsets) -> pd.DataFrame:
+    rows = []
+    for subset in subsets:
+        for method, recs in _records_for(records, manifest, subset).items():
+            s = summarize([r["outcome"] for r in recs], [r["detection_s"] for r in recs])
+            rows.append({"method": method, "subset": subset, **s})
+    return pd.DataFrame(rows)
+
+
+def by_fault_table(records: list[dict], manifest: pd.DataFrame, subsets) -> pd.DataFrame:
+    info = manifest.set_index("flight")
+    rows = []
+    for subset in subsets:
+        for method, recs in _records_for(records, manifest, subset).items():
+            groups = {c: [r for r in recs if r["fault_class"] == c] for c in FAULT_ORDER}
+            groups["total"] = recs
+            for fault_class, group in groups.items():
+                if not group:
+                    continue
+                s = summarize([r["outcome"] for r in group], [r["detection_s"] for r in group])
+                flights = [r["flight"] for r in group]
+                rows.append({
+                    "method": method, "subset": subset, "fault_class": fault_class,
+                    "flights": len(group),
+                    "flight_time_s": float(info.loc[flights, "flight_s"].sum()),
+                    "pre_fault_s": float(info.loc[flights, "pre_fault_s"].sum()),
+                    "mean_detection_s": s["mean_detection_s"],
+                    "max_detection_s": s["max_detection_s"],
+                    "accuracy": s["accuracy"],
+                })
+    return pd.DataFrame(rows)
+
+
+def _fmt(v, pct=False, digits=2) -> str:
+    if v is None or (isinstance(v, float) and math.isnan(v)):
+        return "-"
+    if isinstance(v, float):
+        return f"{100 * v:.{digits}f}" if pct else f"{v:.{digits}f}"
+    return str(v)
+
+
+def _markdown(header: list[str], rows: list[list[str]]) -> str:
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(r) + " |" for r in rows]
+    return "\n".join(lines) + "\n"
+
+
+def summary_markdown(summary: pd.DataFrame) -> str:
+    """Per subset, a table of methods, with the paper's row under ``icra22``."""
+    header = ["method", "flights", "TP", "FP", "FN", "TN", "precision %", "recall %",
+              "accuracy %", "mean det. s", "max det. s"]
+
+    def cells(name, s):
+        return [name, str(s["flights"]), str(s["tp"]), str(s["fp"]), str(s["fn"]),
+                str(s["tn"]), _fmt(s["precision"], True), _fmt(s["recall"], True),
+                _fmt(s["accuracy"], True), _fmt(s["mean_detection_s"]),
+                _fmt(s["max_detection_s"])]
+
+    out = []
+    for subset, table in summary.groupby("subset", sort=False):
+        rows = [cells(r["method"], r) for r in table.to_dict(orient="records")]
+        if subset == "icra22":
+            rows.append(cells(ICRA2019_NAME, ICRA2019_SUMMARY))
+        out.append(f"### Subset `{subset}`\n\n" + _markdown(header, rows))
+    return "\n".join(out)
+
+
+def by_fault_markdown(by_fault: pd.DataFrame) -> str:
+    """Per method and subset, Table I's layout; the paper's values beside ``icra22``."""
+    out = []
+    for (method, subset), table in by_fault.groupby(["method", "subset"], sort=False):
+        paper = subset == "icra22"
+        header = ["fault", "flights", "flight time s", "pre-fault s", "mean det. s",
+                  "max det. s", "accuracy %"]
+        if paper:
+            header += ["paper: flights", "paper: flight time s", "paper: mean det. s",
+                       "paper: max det. s", "paper: accuracy %"]
+        rows = []
+        for r in table.to_dict(orient="records"):
+            row = [r["fault_class"], str(r["flights"]), _fmt(r["flight_time_s"], digits=1),
+                   _fmt(r["pre_fault_s"], digits=1), _fmt(r["mean_detection_s"]),
+                   _fmt(r["max_detection_s"]), _fmt(r["accuracy"], True)]
+            if paper:
+                ref = ICRA2019_BY_FAULT.get(r["fault_class"], (None,) * 5)
+                row += [_fmt(ref[0]), _fmt(ref[1]), _fmt(ref[2]), _fmt(ref[3]),
+                        _fmt(ref[4], True)]
+            rows.append(row)
+        out.append(f"### `{method}` on `{subset}`\n\n" + _markdown(header, rows))
+    return "\n".join(out)
