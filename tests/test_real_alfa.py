@@ -1,0 +1,45 @@
+"""Checks on the real ALFA flights (skipped, and said so in the header, without ALFA_DIR)."""
+
+import pandas as pd
+import pytest
+
+from alfa_bench.analysis import detection_record
+from alfa_bench.data import build_manifest, load_flight, subset_flights
+
+
+@pytest.fixture(scope="module")
+def manifest(real_processed):
+    return build_manifest(real_processed)
+
+
+def test_icra22_subset_has_the_papers_flights(manifest):
+    icra = manifest[manifest["flight"].isin(subset_flights(manifest, "icra22"))]
+    assert len(icra) == 22
+    assert icra["fault_class"].value_counts().to_dict() == {
+        "engine": 7, "none": 5, "aileron": 4, "rudder": 3, "elevator": 2, "rudder+aileron": 1}
+
+
+def test_all_subset_is_every_flight_with_ground_truth(manifest):
+    everything = subset_flights(manifest, "all")
+    assert len(everything) == manifest["ground_truth"].sum()
+    assert not any("no_ground_truth" in f for f in everything)
+
+
+def test_onsets_match_the_authors_table(manifest, real_processed):
+    table = real_processed.parent / "sequences.csv"
+    if not table.exists():
+        pytest.skip(f"{table} not present")
+    seq = pd.read_csv(table).set_index("sequence")
+    for row in manifest[manifest["onset_s"].notna()].itertuples():
+        flight = load_flight(real_processed / row.flight)
+        onset_ns = flight.t0_ns + round(row.onset_s * 1e9)
+        assert abs(onset_ns - int(seq.loc[row.flight, "onset_time_ns"])) < 1000, row.flight
+
+
+def test_a_real_flight_gives_a_complete_record(manifest, real_processed):
+    row = manifest[manifest["fault_class"] == "engine"].iloc[0]
+    record = detection_record("rls_arx_zscore", {"detector": "rls_arx_zscore"},
+                              load_flight(real_processed / row["flight"]), row["sha256"])
+    assert record["outcome"] in {"TP", "FP", "FN", "TN", "FP+FN"}
+    assert record["grid"]["samples"] > 25 * 60
+    assert set(record["pair_first_alarm_s"]) == {"roll", "roll_error", "pitch", "pitch_error"}
