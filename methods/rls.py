@@ -61,9 +61,6 @@ class RecursiveLeastSquares:
         self.step_ = np.zeros(self.n_params)
         return self
 
-    def predict(self, phi: np.ndarray) -> float:
-        return float(phi @ self.theta_)
-
     def update(self, phi: np.ndarray, y: float) -> float:
         """One RLS step; returns the a-priori error :math:`\\hat e(k)`."""
         lam = self.forgetting
