@@ -97,7 +97,6 @@ class _Pair:
         self.var_from = None          # step where the variance began to hold still
         self.var_stable = False
         self.last_var = math.nan
-        self.z = math.nan
 
 
 class RlsArxZscore(Detector):
@@ -128,7 +127,7 @@ class RlsArxZscore(Detector):
     ----------
     pairs_ : list
         Per-pair state: ``rls`` (with ``theta_``, ``error_``, ``gain_``),
-        ``welford``, flags ``model_stable`` and ``var_stable``, last ``z``.
+        ``welford``, flags ``model_stable`` and ``var_stable``.
     """
 
     def __init__(self, pairs=DEFAULT_PAIRS, rate_hz=25.0, na=1, input_window_s=1.0,
@@ -213,5 +212,4 @@ class RlsArxZscore(Detector):
                 p.var_from = None
             p.var_stable = p.var_from is not None and k - p.var_from >= self.var_steps_
         p.last_var = var
-        p.z = z
         return z

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+import yaml
 
 REPO = Path(__file__).resolve().parent.parent
 SNAKEMAKE = [sys.executable, "-m", "snakemake"]
@@ -32,8 +33,7 @@ def runs(corpus, tmp_path_factory):
 
 def test_outputs_and_their_contents(runs, corpus):
     out = runs[0] / "results"
-    config = json.loads(json.dumps(__import__("yaml").safe_load(
-        (REPO / "config/config.yaml").read_text())))
+    config = yaml.safe_load((REPO / "config/config.yaml").read_text())
     summary = pd.read_csv(out / "tables/summary.csv")
     assert set(summary["method"]) == set(config["methods"])
     assert list(summary.columns) == [
