@@ -1,9 +1,17 @@
 """Scoring, tables and provenance of detector runs."""
 
-from .detections import detection_record, read_records, write_record
+from .calibration import folds
+from .detections import detect_all, detection_record, read_records, write_record
 from .scoring import OUTCOMES, flight_outcome, summarize
-from .tables import by_fault_markdown, by_fault_table, summary_markdown, summary_table
+from .tables import (
+    by_fault_markdown,
+    by_fault_table,
+    comparison_markdown,
+    comparison_table,
+    summary_markdown,
+    summary_table,
+)
 
-__all__ = ["OUTCOMES", "by_fault_markdown", "by_fault_table", "detection_record",
-           "flight_outcome", "read_records", "summarize", "summary_markdown",
-           "summary_table", "write_record"]
+__all__ = ["OUTCOMES", "by_fault_markdown", "by_fault_table", "comparison_markdown",
+           "comparison_table", "detect_all", "detection_record", "flight_outcome", "folds",
+           "read_records", "summarize", "summary_markdown", "summary_table", "write_record"]

@@ -1,27 +1,56 @@
-"""Run a configured method over one flight and describe the result as a record.
+"""Run a configured method over flights and describe each result as a record.
 
-The record is what ``results/detections/{method}/{flight}.json`` holds.
+The record is what ``results/detections/{method}/{flight}.json`` holds. A calibrated
+method is fitted once per fold of :func:`~.calibration.folds`, on the fault-free data
+of the other folds' flights only, and each record names those flights.
 """
 
 from __future__ import annotations
 
 import json
+import logging
+from collections.abc import Iterator
 from pathlib import Path
 
-from alfa_bench.data import Flight
-from alfa_bench.methods import make_detector, run_detector
+import pandas as pd
 
+from alfa_bench.data import Flight
+from alfa_bench.methods import Detector, fault_free_segments, make_detector, run_detector
+
+from .calibration import folds
 from .provenance import provenance
 from .scoring import flight_outcome
 
-__all__ = ["detection_record", "read_records", "write_record"]
+__all__ = ["detect_all", "detection_record", "read_records", "write_record"]
+
+log = logging.getLogger(__name__)
 
 
-def detection_record(method: str, spec: dict, flight: Flight, flight_sha256: str) -> dict:
-    """Run ``spec`` (``{"detector": name, "params": {...}}``) on ``flight``."""
+def detect_all(method: str, spec: dict, flights: dict[str, Flight], manifest: pd.DataFrame,
+               calibration: dict) -> Iterator[dict]:
+    """Records of ``spec`` (``{"detector": name, "params": {...}}``) on every flight of
+    ``manifest`` with ground truth; ``calibration`` is ``{"group_by", "margin_s"}``."""
+    detector = make_detector(spec["detector"], spec.get("params"))
+    sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
+    if not detector.calibrated:
+        for name in manifest.loc[manifest["ground_truth"], "flight"]:
+            yield detection_record(method, spec, detector, flights[name], sha[name])
+        return
+    for fold, (scored, training) in folds(manifest, calibration["group_by"]).items():
+        detector.fit(fault_free_segments(detector, [flights[f] for f in training],
+                                         calibration["margin_s"]))
+        log.info("%s: fold %s fitted on %d flights", method, fold, len(training))
+        info = {**calibration, "fold": fold, "flights": list(training),
+                "fitted": detector.fitted()}
+        for name in scored:
+            yield detection_record(method, spec, detector, flights[name], sha[name], info)
+
+
+def detection_record(method: str, spec: dict, detector: Detector, flight: Flight,
+                     flight_sha256: str, calibration: dict | None = None) -> dict:
+    """Run ``detector`` (fitted if calibrated) on ``flight``."""
     if flight.fault is None:
         raise ValueError(f"flight {flight.id} has no ground truth and cannot be scored")
-    detector = make_detector(spec["detector"], spec.get("params"))
     trace = run_detector(detector, flight)
     onset = flight.fault.onset_s
     first = trace.first_alarm_s()
@@ -44,7 +73,7 @@ def detection_record(method: str, spec: dict, flight: Flight, flight_sha256: str
         "grid": {"rate_hz": detector.rate_hz, "samples": int(trace.t.size),
                  "start_s": float(trace.t[0]), "stop_s": float(trace.t[-1])},
         "repairs": list(flight.repairs),
-        "calibration_flights": [],
+        "calibration": calibration,
         "provenance": provenance(spec, {"flight_sha256": flight_sha256}),
     }
 

@@ -55,6 +55,15 @@ SIGNALS: dict[str, Signal] = {
     **_attitude("yaw"),
     "airspeed_cmd": Signal("mavros-nav_info-airspeed", "field.commanded", unit="m/s"),
     "airspeed": Signal("mavros-nav_info-airspeed", "field.measured", unit="m/s"),
+    # body rates from the raw IMU, the freshest sensor in ALFA (~10 Hz, every row new)
+    "roll_rate": Signal("mavros-imu-data_raw", "field.angular_velocity.x", unit="rad/s"),
+    "pitch_rate": Signal("mavros-imu-data_raw", "field.angular_velocity.y", unit="rad/s"),
+    "yaw_rate": Signal("mavros-imu-data_raw", "field.angular_velocity.z", unit="rad/s"),
+    # servo outputs (~3 Hz). ALFA does not name the channels; the mapping follows the
+    # data: channels4 and 5 are identical and track roll rate (ailerons, r ~ 0.6-0.9),
+    # channels1 tracks pitch rate (elevator, r ~ 0.6-0.9).
+    "aileron_cmd": Signal("mavros-rc-out", "field.channels4", unit="us"),
+    "elevator_cmd": Signal("mavros-rc-out", "field.channels1", unit="us"),
 }
 
 
@@ -77,6 +86,11 @@ class Sampled:
     x: np.ndarray
     fresh: np.ndarray
     names: tuple[str, ...]
+
+    def before(self, t_s: float) -> Sampled:
+        """The grid steps strictly before ``t_s``."""
+        n = int(np.searchsorted(self.t, t_s, side="left"))
+        return Sampled(t=self.t[:n], x=self.x[:n], fresh=self.fresh[:n], names=self.names)
 
 
 def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float) -> Sampled:

@@ -4,6 +4,12 @@ A detector is built from hyper-parameters only; :meth:`Detector.reset` creates i
 learned state (attributes ending in ``_``); :meth:`Detector.update` consumes one
 time step of the signals it asks for and returns, per score channel, the score and
 the alarm of that step. A flight alarms when any channel alarms.
+
+A *calibrated* detector also learns from fault-free data before it runs:
+:meth:`Detector.fit` takes fault-free segments (whole fault-free flights and the
+pre-fault parts of the others, never the flight to be scored) and sets its fitted
+attributes (ending in ``_``, kept by :meth:`~Detector.reset`);
+:meth:`~Detector.fitted` reports them for the detection record.
 """
 
 from __future__ import annotations
@@ -14,9 +20,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from alfa_bench.data import Flight, sample
+from alfa_bench.data import Flight, Sampled, sample
 
-__all__ = ["Detector", "Trace", "run_detector"]
+__all__ = ["Detector", "NotFittedError", "Trace", "fault_free_segments", "run_detector"]
+
+
+class NotFittedError(RuntimeError):
+    """A calibrated detector was run before :meth:`Detector.fit`."""
 
 
 class Detector(ABC):
@@ -28,6 +38,8 @@ class Detector(ABC):
 
     #: grid rate of the samples :meth:`update` expects, Hz
     rate_hz: float
+    #: whether :meth:`fit` must see fault-free data before the detector can run
+    calibrated: bool = False
 
     def get_params(self) -> dict:
         """Hyper-parameters by name, as passed to ``__init__``."""
@@ -42,9 +54,24 @@ class Detector(ABC):
     def channels(self) -> tuple[str, ...]:
         """Names of the score channels."""
 
+    def fit(self, segments: list[Sampled]) -> Detector:
+        """Learn from fault-free ``segments`` (sampled with :meth:`signals` at
+        :attr:`rate_hz`); return self. Uncalibrated detectors learn nothing here."""
+        return self
+
+    def fitted(self) -> dict:
+        """What :meth:`fit` learned, as JSON-ready values (empty if uncalibrated)."""
+        return {}
+
+    def _check_fitted(self, attribute: str) -> None:
+        if not hasattr(self, attribute):
+            raise NotFittedError(f"{type(self).__name__} is calibrated: call fit() on "
+                                 "fault-free segments before running it")
+
     @abstractmethod
     def reset(self) -> Detector:
-        """Forget everything learned; return self."""
+        """Forget everything learned while running (not what :meth:`fit` learned);
+        return self."""
 
     @abstractmethod
     def update(self, x: np.ndarray, fresh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -105,3 +132,24 @@ def run_detector(detector: Detector, flight: Flight) -> Trace:
     for k in range(n):
         score[k], alarm[k] = detector.update(s.x[k], s.fresh[k])
     return Trace(t=s.t, score=score, alarm=alarm, channels=detector.channels())
+
+
+def fault_free_segments(detector: Detector, flights: list[Flight],
+                        margin_s: float) -> list[Sampled]:
+    """The fault-free data of ``flights``, sampled as ``detector`` reads it.
+
+    A fault-free flight gives all of itself, a faulty one its grid steps before
+    ``onset - margin_s`` (the onset is known only to the ground truth's period). A
+    flight without ground truth cannot tell its fault-free part and is refused.
+    """
+    segments = []
+    for flight in flights:
+        if flight.fault is None:
+            raise ValueError(f"flight {flight.id} has no ground truth: its fault-free part "
+                             "is unknown, so it cannot calibrate")
+        s = sample(flight, detector.signals(), detector.rate_hz)
+        if flight.fault.onset_s is not None:
+            s = s.before(flight.fault.onset_s - margin_s)
+        if s.t.size:
+            segments.append(s)
+    return segments

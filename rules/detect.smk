@@ -6,6 +6,7 @@ rule detect:
     params:
         spec=lambda w: config["methods"][w.method],
         processed=str(PROCESSED),
+        calibration=config["calibration"],
     log:
         "results/logs/detect/{method}.log",
     benchmark:

@@ -3,7 +3,7 @@
 import logging
 from pathlib import Path
 
-from alfa_bench.analysis import detection_record, write_record
+from alfa_bench.analysis import detect_all, write_record
 from alfa_bench.analysis.logs import log_to
 from alfa_bench.data import load_flight, read_manifest
 
@@ -12,8 +12,10 @@ log_to(sm.log[0])
 manifest = read_manifest(sm.input.manifest)
 out = Path(sm.output[0])
 out.mkdir(parents=True, exist_ok=True)
-for row in manifest[manifest["ground_truth"]].itertuples():
-    flight = load_flight(Path(sm.params.processed) / row.flight)
-    record = detection_record(sm.wildcards.method, dict(sm.params.spec), flight, row.sha256)
-    write_record(record, out / f"{row.flight}.json")
-    logging.info("%s: %s, first alarm %s", row.flight, record["outcome"], record["first_alarm_s"])
+flights = {name: load_flight(Path(sm.params.processed) / name)
+           for name in manifest.loc[manifest["ground_truth"], "flight"]}
+for record in detect_all(sm.wildcards.method, dict(sm.params.spec), flights, manifest,
+                         dict(sm.params.calibration)):
+    write_record(record, out / f"{record['flight']}.json")
+    logging.info("%s: %s, first alarm %s", record["flight"], record["outcome"],
+                 record["first_alarm_s"])

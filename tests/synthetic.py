@@ -1,8 +1,9 @@
 """Small synthetic flights in ALFA's on-disk format, made by the tests themselves.
 
-Roll and pitch follow a known first-order ARX law from their commands; after the
-fault onset the law changes (the control surface stops answering), which is the
-kind of change the detectors are built to see.
+Roll and pitch follow a known first-order ARX law from their commands, and the body
+rates (``imu-data_raw``, 10 Hz) a known law from the servo outputs (``rc-out``, 3 Hz);
+after the fault onset both laws change (the control surface stops answering), which
+is the kind of change the detectors are built to see.
 """
 
 from __future__ import annotations
@@ -38,6 +39,39 @@ def attitude_rows(t_ns, commanded, measured) -> list[str]:
                                   measured.tolist(), strict=True)]
 
 
+IMU_HEADER = ("%time,field.header.seq,field.header.stamp,field.header.frame_id,"
+              "field.angular_velocity.x,field.angular_velocity.y,field.angular_velocity.z")
+RC_HEADER = ("%time,field.header.seq,field.header.stamp,field.header.frame_id,"
+             + ",".join(f"field.channels{i}" for i in range(8)))
+
+
+def rate_topics(folder: Path, name: str, duration_s: float, onset_s: float | None,
+                rng: np.random.Generator) -> None:
+    """rc-out at 3 Hz and the body rates at 10 Hz answering the held servo outputs:
+    p = 2.5 da, q = 2 de, r(k) = 0.9 r(k-1) + 0.1 da (p and q stop answering at onset)."""
+    rc_t = np.arange(0.0, duration_s, 1 / 3)
+    da = 0.3 * np.sin(0.8 * rc_t) + rng.uniform(-0.2, 0.2, rc_t.size)
+    de = 0.2 * np.sin(0.5 * rc_t + 1) + rng.uniform(-0.2, 0.2, rc_t.size)
+    pwm = np.full((rc_t.size, 8), 1500)
+    pwm[:, 4] = pwm[:, 5] = np.round(1500 + 500 * da)
+    pwm[:, 1] = np.round(1500 + 500 * de)
+    rc_ns = T0_NS + 2_000_000 + np.round(rc_t * 1e9).astype(np.int64)
+    write_csv(folder / f"{name}-mavros-rc-out.csv", RC_HEADER,
+              [f"{t},{i},{t - 100_000},," + ",".join(map(str, row))
+               for i, (t, row) in enumerate(zip(rc_ns.tolist(), pwm.tolist(), strict=True))])
+    imu_t = np.arange(0.5, duration_s, 0.1)
+    held = np.searchsorted(rc_t, imu_t + 0.001, side="right") - 1
+    gain = np.where(onset_s is not None and imu_t >= (onset_s or 0), 0.1, 1.0)
+    p = gain * 2.5 * da[held] + rng.normal(0, 0.05, imu_t.size)
+    q = gain * 2.0 * de[held] + rng.normal(0, 0.05, imu_t.size)
+    r = arx_response(da[held], 0.9, 0.1, rng.normal(0, 0.01, imu_t.size))
+    imu_ns = T0_NS + 3_000_000 + np.round(imu_t * 1e9).astype(np.int64)
+    write_csv(folder / f"{name}-mavros-imu-data_raw.csv", IMU_HEADER,
+              [f"{t},{i},{t - 100_000},base_link,{a!r},{b!r},{c!r}"
+               for i, (t, a, b, c) in enumerate(zip(imu_ns.tolist(), p.tolist(), q.tolist(),
+                                                    r.tolist(), strict=True))])
+
+
 def write_csv(path: Path, header: str, rows: list[str]) -> None:
     path.write_text("\n".join([header, *rows]) + "\n")
 
@@ -62,6 +96,7 @@ def write_flight(processed: Path, name: str, *, duration_s: float = 80.0, rate_h
         measured = np.where(faulty, y_fault, y)
         write_csv(folder / f"{name}-mavros-nav_info-{axis}.csv", ATTITUDE_HEADER,
                   attitude_rows(t_ns + i * 3_000_000, u, measured))
+    rate_topics(folder, name, duration_s, onset_s, rng)
     if onset_s is not None:
         gt_t = np.arange(onset_s, duration_s, 1 / gt_rate_hz)
         gt_ns = T0_NS + 1_000_000 + np.round(gt_t * 1e9).astype(np.int64)

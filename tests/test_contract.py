@@ -1,8 +1,11 @@
 """The streaming contract, checked for every registered detector and configured run.
 
-A new method is picked up here by its registry line alone.
+A new method is picked up here by its registry line alone. Calibrated detectors are
+fitted first, on the fault-free flights of the synthetic corpus.
 """
 
+import copy
+import json
 import shutil
 from pathlib import Path
 
@@ -11,7 +14,13 @@ import pytest
 import yaml
 
 from alfa_bench.data import load_flight
-from alfa_bench.methods import REGISTRY, make_detector, run_detector
+from alfa_bench.methods import (
+    REGISTRY,
+    NotFittedError,
+    fault_free_segments,
+    make_detector,
+    run_detector,
+)
 
 CONFIG = yaml.safe_load((Path(__file__).parent.parent / "config/config.yaml").read_text())
 RUNS = {name: (spec["detector"], spec.get("params", {})) for name, spec in
@@ -21,9 +30,27 @@ CASES = {**{f"registry:{n}": (n, {}) for n in REGISTRY}, **{f"config:{n}": r for
 
 
 @pytest.fixture(params=sorted(CASES))
-def detector(request):
+def unfitted(request):
     name, params = CASES[request.param]
     return make_detector(name, params)
+
+
+def fit(detector, corpus):
+    """``detector`` fitted on the corpus's fault-free data (no-op if uncalibrated)."""
+    training = [load_flight(p) for p in sorted(corpus.iterdir())]
+    return detector.fit(fault_free_segments(detector, training, margin_s=1.0))
+
+
+_FITTED = {}
+
+
+@pytest.fixture
+def detector(request, unfitted, corpus):
+    """A fitted detector that has never run (fitting is cached across tests)."""
+    key = request.node.callspec.params["unfitted"]
+    if key not in _FITTED:
+        _FITTED[key] = fit(unfitted, corpus)
+    return copy.deepcopy(_FITTED[key])
 
 
 def assert_same(a, b, upto=None):
@@ -33,12 +60,24 @@ def assert_same(a, b, upto=None):
     np.testing.assert_array_equal(a.alarm[sl], b.alarm[sl])
 
 
-def test_constructor_stores_hyper_parameters_only(detector):
-    assert set(vars(detector)) == set(detector.get_params())
-    before = set(vars(detector))
-    detector.reset()
-    learned = set(vars(detector)) - before
+def test_constructor_stores_hyper_parameters_only(unfitted, corpus):
+    assert set(vars(unfitted)) == set(unfitted.get_params())
+    before = set(vars(unfitted))
+    fit(unfitted, corpus).reset()
+    learned = set(vars(unfitted)) - before
     assert learned and all(a.endswith("_") for a in learned)
+
+
+def test_calibrated_detectors_refuse_to_run_unfitted(unfitted, one_flight):
+    if not unfitted.calibrated:
+        assert unfitted.fitted() == {}
+        return
+    with pytest.raises(NotFittedError, match="fit"):
+        run_detector(unfitted, load_flight(one_flight))
+
+
+def test_fitted_values_are_json_ready(detector):
+    json.dumps(detector.fitted(), allow_nan=False)
 
 
 def test_outputs_have_the_declared_shape(detector, one_flight):
@@ -57,7 +96,8 @@ def test_reset_forgets_the_previous_flight(detector, corpus, one_flight):
     other = load_flight(next(p for p in corpus.iterdir() if "no_failure" in p.name))
     flight = load_flight(one_flight)
     run_detector(detector, other)
-    fresh = type(detector)(**detector.get_params())
+    fresh = fit(type(detector)(**detector.get_params()), corpus)
+    assert fresh.fitted() == detector.fitted()
     assert_same(run_detector(detector, flight), run_detector(fresh, flight))
 
 
@@ -67,7 +107,7 @@ def test_causal(detector, one_flight, tmp_path):
     base = run_detector(detector, flight)
     cut_s = 0.7 * float(base.t[-1])
     altered = shutil.copytree(one_flight, tmp_path / "altered" / one_flight.name)
-    for f in altered.glob("*nav_info*.csv"):
+    for f in altered.glob("*mavros*.csv"):
         lines = f.read_text().splitlines()
         t_ns = np.array([int(line.split(",", 1)[0]) for line in lines[1:]])
         cut_ns = flight.t0_ns + int(cut_s * 1e9)

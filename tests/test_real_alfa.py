@@ -1,10 +1,14 @@
 """Checks on the real ALFA flights (skipped, and said so in the header, without ALFA_DIR)."""
 
+import json
+
+import numpy as np
 import pandas as pd
 import pytest
 
 from alfa_bench.analysis import detection_record
 from alfa_bench.data import build_manifest, load_flight, subset_flights
+from alfa_bench.methods import REGISTRY, fault_free_segments, make_detector, run_detector
 
 
 @pytest.fixture(scope="module")
@@ -39,7 +43,21 @@ def test_onsets_match_the_authors_table(manifest, real_processed):
 def test_a_real_flight_gives_a_complete_record(manifest, real_processed):
     row = manifest[manifest["fault_class"] == "engine"].iloc[0]
     record = detection_record("rls_arx_zscore", {"detector": "rls_arx_zscore"},
+                              make_detector("rls_arx_zscore"),
                               load_flight(real_processed / row["flight"]), row["sha256"])
     assert record["outcome"] in {"TP", "FP", "FN", "TN", "FP+FN"}
     assert record["grid"]["samples"] > 25 * 60
     assert set(record["pair_first_alarm_s"]) == {"roll", "roll_error", "pitch", "pitch_error"}
+
+
+@pytest.mark.parametrize("name", sorted(n for n, c in REGISTRY.items() if c.calibrated))
+def test_calibrated_detectors_fit_and_run_on_real_flights(name, manifest, real_processed):
+    """Fitted on the first day's flights, run on a flight of another day."""
+    first = manifest["date"].iloc[0]
+    training = [load_flight(real_processed / f) for f in
+                manifest.loc[(manifest["date"] == first) & manifest["ground_truth"], "flight"]]
+    scored = manifest.loc[manifest["date"] != first, "flight"].iloc[0]
+    det = make_detector(name).fit(fault_free_segments(make_detector(name), training, 1.0))
+    trace = run_detector(det, load_flight(real_processed / scored))
+    assert np.isfinite(trace.score).any(axis=0).all()     # every channel arms
+    json.dumps(det.fitted(), allow_nan=False)             # finite, JSON-ready

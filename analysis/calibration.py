@@ -1,0 +1,32 @@
+"""Leave-one-group-out folds: no flight is scored by a model or threshold that saw it.
+
+Each fold holds out one group of flights (a day, by default, since flights of one
+day share the aircraft's trim, wind and the segments of one recording) and
+calibrates on the fault-free data of every other flight with ground truth.
+"""
+
+from __future__ import annotations
+
+import pandas as pd
+
+__all__ = ["GROUPINGS", "folds"]
+
+#: manifest column that defines a group
+GROUPINGS = {"date": "date", "flight": "flight"}
+
+
+def folds(manifest: pd.DataFrame, group_by: str) -> dict[str, tuple[list[str], list[str]]]:
+    """Group -> (flights it scores, flights that calibrate it), over flights with
+    ground truth, in manifest order."""
+    if group_by not in GROUPINGS:
+        raise ValueError(f"group_by must be one of {sorted(GROUPINGS)}, got {group_by!r}")
+    labelled = manifest[manifest["ground_truth"]]
+    groups = labelled[GROUPINGS[group_by]].astype(str)
+    out = {}
+    for g in dict.fromkeys(groups):
+        held = groups == g
+        out[g] = (labelled.loc[held, "flight"].tolist(), labelled.loc[~held, "flight"].tolist())
+    if len(out) < 2:
+        raise ValueError(f"calibration needs flights from at least two {group_by} groups; "
+                         f"found {len(out)}")
+    return out

@@ -1,0 +1,71 @@
+"""Calibration without leakage: folds, fault-free segments, and what records say."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from alfa_bench.analysis import detect_all, folds
+from alfa_bench.data import build_manifest, load_flight
+from alfa_bench.methods import fault_free_segments, make_detector
+
+CALIBRATION = {"group_by": "date", "margin_s": 1.0}
+
+
+@pytest.fixture(scope="module")
+def manifest(corpus):
+    return build_manifest(corpus)
+
+
+@pytest.fixture(scope="module")
+def flights(corpus, manifest):
+    return {f: load_flight(corpus / f) for f in manifest["flight"]}
+
+
+@pytest.mark.parametrize("group_by", ["date", "flight"])
+def test_every_labelled_flight_is_scored_once_by_a_fold_that_never_saw_it(manifest,
+                                                                            group_by):
+    out = folds(manifest, group_by)
+    scored = [f for s, _ in out.values() for f in s]
+    assert sorted(scored) == sorted(manifest.loc[manifest["ground_truth"], "flight"])
+    date = dict(zip(manifest["flight"], manifest["date"], strict=True))
+    for held, training in out.values():
+        assert not set(held) & set(training)
+        if group_by == "date":
+            assert not {date[f] for f in held} & {date[f] for f in training}
+
+
+def test_a_single_group_cannot_calibrate(manifest):
+    one_day = manifest[manifest["date"] == manifest["date"].iloc[0]]
+    with pytest.raises(ValueError, match="at least two"):
+        folds(one_day, "date")
+
+
+def test_segments_stop_before_onset_and_refuse_unlabelled_flights(flights):
+    det = make_detector("glrt_residuals")
+    names = sorted(flights)
+    segments = fault_free_segments(det, [flights[n] for n in names], margin_s=1.0)
+    for name, s in zip(names, segments, strict=True):
+        onset = flights[name].fault.onset_s
+        if onset is None:
+            assert s.t[-1] > 70.0                       # the whole fault-free flight
+        else:
+            assert s.t[-1] < onset - 1.0 <= s.t[-1] + 1 / det.rate_hz
+    unlabelled = dataclasses.replace(flights[names[0]], fault=None)
+    with pytest.raises(ValueError, match="no ground truth"):
+        fault_free_segments(det, [unlabelled], margin_s=1.0)
+
+
+def test_records_name_their_calibration_flights_and_fitted_values(corpus, manifest):
+    flights = {f: load_flight(corpus / f) for f in manifest["flight"]}
+    spec = {"detector": "glrt_residuals", "params": {}}
+    records = list(detect_all("glrt_arx", spec, flights, manifest, CALIBRATION))
+    assert sorted(r["flight"] for r in records) == sorted(manifest["flight"])
+    date = dict(zip(manifest["flight"], manifest["date"], strict=True))
+    for r in records:
+        cal = r["calibration"]
+        assert r["flight"] not in cal["flights"] and cal["flights"]
+        assert date[r["flight"]] == cal["fold"]
+        assert all(date[f] != cal["fold"] for f in cal["flights"])
+        assert np.all(np.isfinite(cal["fitted"]["threshold"]))
+        assert cal["group_by"] == "date" and cal["margin_s"] == 1.0
