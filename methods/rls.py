@@ -14,6 +14,13 @@ with :math:`\hat\theta(0) = 0` and :math:`C(0) = p_0 I`. The paper's form is
 Hansen et al. With :math:`\lambda = 1` the estimate after :math:`k` steps is
 exactly the ridge solution
 :math:`(\Phi^T\Phi + I/p_0)^{-1}\Phi^T y`, which the tests use as reference.
+
+With :math:`\lambda < 1` and a regressor that stops varying (level flight, a held
+command), (7) divides the unexcited directions of :math:`C` by :math:`\lambda` at
+every step: the covariance winds up as :math:`\lambda^{-k}` and the next excitation
+throws :math:`\hat\theta` about. ``max_trace`` guards against this: whenever
+:math:`\operatorname{tr} C(k)` exceeds it, :math:`C(k)` is scaled back onto
+:math:`\operatorname{tr} C = ` ``max_trace`` (a bounded-trace forgetting).
 """
 
 from __future__ import annotations
@@ -35,6 +42,8 @@ class RecursiveLeastSquares:
         :math:`\\hat\\theta(0) = 0`.
     forgetting : float
         :math:`\\lambda \\in (0, 1]`.
+    max_trace : float
+        Bound on :math:`\\operatorname{tr} C(k)`; ``inf`` for none.
 
     Attributes
     ----------
@@ -46,16 +55,23 @@ class RecursiveLeastSquares:
         :math:`\\hat e(k)`, :math:`L(k)` and :math:`L(k)\\hat e(k)` of the last update.
     """
 
-    def __init__(self, n_params: int, p0: float = 1e6, forgetting: float = 1.0):
+    def __init__(self, n_params: int, p0: float = 1e6, forgetting: float = 1.0,
+                 max_trace: float = np.inf):
         self.n_params = n_params
         self.p0 = p0
         self.forgetting = forgetting
+        self.max_trace = max_trace
 
-    def reset(self) -> RecursiveLeastSquares:
+    def reset(self, theta: np.ndarray | None = None,
+              cov: np.ndarray | None = None) -> RecursiveLeastSquares:
+        """Start from :math:`\\hat\\theta(0)` = ``theta`` (zeros) and
+        :math:`C(0)` = ``cov`` (:math:`p_0 I`)."""
         if not 0.0 < self.forgetting <= 1.0:
             raise ValueError(f"forgetting must be in (0, 1], got {self.forgetting}")
-        self.theta_ = np.zeros(self.n_params)
-        self.cov_ = np.eye(self.n_params) * self.p0
+        if not self.max_trace > 0:
+            raise ValueError(f"max_trace must be > 0, got {self.max_trace}")
+        self.theta_ = np.zeros(self.n_params) if theta is None else np.array(theta, float)
+        self.cov_ = np.eye(self.n_params) * self.p0 if cov is None else np.array(cov, float)
         self.error_ = np.nan
         self.gain_ = np.zeros(self.n_params)
         self.step_ = np.zeros(self.n_params)
@@ -70,6 +86,10 @@ class RecursiveLeastSquares:
         step = gain * e
         self.theta_ = self.theta_ + step               # (6) theta += L e
         cov = (self.cov_ - np.outer(gain, c_phi)) / lam  # (7) C = (C - L phi' C) / lam
-        self.cov_ = 0.5 * (cov + cov.T)                # keep C symmetric against round-off
+        cov = 0.5 * (cov + cov.T)                      # keep C symmetric against round-off
+        trace = np.trace(cov)
+        if trace > self.max_trace:
+            cov *= self.max_trace / trace              # tr C <= max_trace: no wind-up
+        self.cov_ = cov
         self.error_, self.gain_, self.step_ = float(e), gain, step
         return self.error_

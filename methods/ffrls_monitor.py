@@ -1,0 +1,282 @@
+r"""Forgetting-factor RLS parameter monitoring (Hansen, Blanke, Adrian 2014, eqs. 11-16).
+
+Simple models relate the commanded surface deflections to the body rates (eqs. 11-13):
+
+.. math::
+
+    p(k) &= a_{pa}\,\delta_a(k) + b_{pa}                          && (11)\\
+    q(k) &= a_{qe}\,\delta_e(k) + b_{qe}                          && (12)\\
+    r(k) &= a_{ra}\,\delta_a(k) + b_{ra}\,r(k-1) + c_{ra}          && (13)
+
+Each is estimated online by RLS with forgetting factor :math:`\lambda_f` (eqs. 14-16;
+:class:`~.rls.RecursiveLeastSquares` computes the same recursion through the matrix
+inversion lemma). In ALFA the rates are the raw IMU's (``mavros-imu-data_raw``, ~10 Hz,
+every row a new measurement) and the deflections the servo outputs of
+``mavros-rc-out`` (~3 Hz, held between rows), as :math:`(\mathrm{PWM} - 1500)/500`,
+the servo's fixed range mapped onto [-1, 1]. The grid is the gyro's 10 Hz. Commanded
+against measured attitude (``nav_info``) would be the alternative, but its measured
+angle refreshes at only ~2.5 Hz and it relates angles, not the rates of the paper.
+
+Two tests per model, both with thresholds read from fault-free data:
+
+``{model}_residual``
+    The windowed GLRT (:mod:`.glrt`) on the prediction error :math:`\varepsilon(k)`
+    of (14), centred and scaled by its fault-free mean and variance; threshold
+    :math:`\gamma_r`, the :math:`1-P_F` quantile of :math:`g` on the training data.
+``{model}_joint``
+    The combined test of parameter change and residual statistic. The parameter
+    change over the GLRT window, :math:`\Delta\hat\theta(k) = \hat\theta(k) -
+    \hat\theta(k-M)`, is scored by :math:`T(k) = \Delta\hat\theta^T \Sigma^{-1}
+    \Delta\hat\theta`, :math:`\Sigma` its fault-free covariance. The test fires when
+    both :math:`g > \gamma_r'` and :math:`T > \gamma_\theta'`, the two lowered
+    thresholds being the :math:`1-q` quantiles of :math:`g` and :math:`T` with the
+    largest :math:`q` whose *joint* exceedance on the training data is at most
+    :math:`P_F`. Its score is :math:`\min(g/\gamma_r', T/\gamma_\theta')`, so it fires
+    above 1.
+
+As the paper prescribes, adaptation stops while the residual statistic is above
+:math:`\gamma_r'`, so a fault is not absorbed into the parameters; the bound on
+:math:`\operatorname{tr}P` (``max_trace_ratio`` times that of the a-priori :math:`P`)
+stops the covariance winding up in steady flight.
+
+Fitted from fault-free data, as the paper suggests: :math:`\hat\theta(0)` and
+:math:`P(0)` are the means of the final estimates over the training segments, each run
+from :math:`\hat\theta = 0`, :math:`P = p_0 I`. The thresholds come from a second pass
+started at those values; that pass does not freeze adaptation (the freezing rule
+needs the thresholds it is computing), so the statistics it sees are those of an
+estimator that never stops; under no fault the two differ only at the fraction
+:math:`q` of steps above :math:`\gamma_r'`.
+
+Choices the paper leaves open (none fitted to scores): :math:`\lambda_f = 0.98`, a
+memory of :math:`1/(1-\lambda_f) = 50` samples (5 s), long enough to average the
+noise, short enough to follow a failed surface within seconds; ``window_s = 2``;
+``max_trace_ratio = 10``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+
+import numpy as np
+
+from alfa_bench.data import Sampled
+
+from .base import Detector
+from .glrt import WindowedGlrt, empirical_threshold
+from .rls import RecursiveLeastSquares
+
+__all__ = ["DEFAULT_MODELS", "FfRlsMonitor", "joint_thresholds"]
+
+#: eqs. (11)-(13): output rate, deflection inputs, and whether r(k-1) is a regressor
+DEFAULT_MODELS = (
+    {"name": "roll", "output": "roll_rate", "inputs": ["aileron_cmd"], "autoregressive": False},
+    {"name": "pitch", "output": "pitch_rate", "inputs": ["elevator_cmd"],
+     "autoregressive": False},
+    {"name": "yaw", "output": "yaw_rate", "inputs": ["aileron_cmd"], "autoregressive": True},
+)
+
+_PWM_CENTRE_US, _PWM_HALF_RANGE_US = 1500.0, 500.0
+
+
+def joint_thresholds(g: np.ndarray, t: np.ndarray, false_alarm: float) -> tuple[float, float]:
+    """Lowered thresholds :math:`(\\gamma_r', \\gamma_\\theta')` at equal marginal levels
+    :math:`q`, the largest with joint exceedance of ``(g, t)`` at most ``false_alarm``."""
+    ok = np.isfinite(g) & np.isfinite(t)
+    g, t = g[ok], t[ok]
+
+    def at(q):
+        return (float(np.quantile(g, 1 - q, method="higher")),
+                float(np.quantile(t, 1 - q, method="higher")))
+
+    def rate(q):
+        tg, tt = at(q)
+        return float(np.mean((g > tg) & (t > tt)))
+
+    lo, hi = false_alarm, 0.5
+    if rate(lo) > false_alarm:
+        return at(lo)
+    for _ in range(40):                     # bisection on q: rate(q) grows with q
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if rate(mid) <= false_alarm else (lo, mid)
+    return at(lo)
+
+
+class _Model:
+    def __init__(self, det: FfRlsMonitor, spec: dict, cols: dict):
+        self.y_col = cols[spec["output"]]
+        self.u_cols = [cols[s] for s in spec["inputs"]]
+        self.ar = bool(spec["autoregressive"])
+        self.n = len(self.u_cols) + self.ar + 1
+        self.rls = RecursiveLeastSquares(self.n, det.p0, det.forgetting,
+                                         det.max_trace_ratio * np.trace(det.cov0_[spec["name"]])
+                                         if hasattr(det, "cov0_") else np.inf)
+        self.y_prev = math.nan
+        self.thetas = deque(maxlen=det._window() + 1)
+        self.frozen = False
+
+
+class FfRlsMonitor(Detector):
+    """FF-RLS on eqs. (11)-(13) with residual and joint parameter tests.
+
+    Parameters
+    ----------
+    models : sequence of dict
+        ``{"name", "output", "inputs", "autoregressive"}``; signal names from
+        :data:`alfa_bench.data.SIGNALS`.
+    rate_hz : float
+    forgetting : float
+        :math:`\\lambda_f`.
+    p0 : float
+        :math:`P = p_0 I` of the first calibration pass.
+    false_alarm : float
+        :math:`P_F` per sample, for both tests.
+    window_s : float
+        GLRT window and parameter-change lag :math:`M`.
+    max_trace_ratio : float
+        Bound on :math:`\\operatorname{tr}P` relative to the fitted a-priori :math:`P`.
+
+    Attributes
+    ----------
+    theta0_, cov0_ : dict
+        Fitted a-priori parameters and covariance per model.
+    res_mean_, res_var_, dtheta_cov_, dtheta_info_ : dict
+        Fault-free statistics of :math:`\\varepsilon` and :math:`\\Delta\\hat\\theta`
+        (``dtheta_info_`` the pseudo-inverse of ``dtheta_cov_``).
+    gamma_r_, gamma_r_joint_, gamma_theta_joint_ : dict
+        Thresholds per model.
+    models_ : list
+        Per-model state: ``rls`` (``theta_``, ``cov_``, ``error_``, ``gain_``),
+        ``frozen``.
+    """
+
+    calibrated = True
+
+    def __init__(self, models=DEFAULT_MODELS, rate_hz=10.0, forgetting=0.98, p0=1e3,
+                 false_alarm=5e-4, window_s=2.0, max_trace_ratio=10.0):
+        self.models = models
+        self.rate_hz = rate_hz
+        self.forgetting = forgetting
+        self.p0 = p0
+        self.false_alarm = false_alarm
+        self.window_s = window_s
+        self.max_trace_ratio = max_trace_ratio
+
+    def signals(self) -> tuple[str, ...]:
+        return tuple(dict.fromkeys(s for m in self.models for s in (*m["inputs"], m["output"])))
+
+    def channels(self) -> tuple[str, ...]:
+        return tuple(f"{m['name']}_{test}" for m in self.models for test in ("residual", "joint"))
+
+    # -- calibration -------------------------------------------------------------------
+
+    def fit(self, segments: list[Sampled]) -> FfRlsMonitor:
+        names = [m["name"] for m in self.models]
+        for attr in ("theta0_", "cov0_", "gamma_r_"):
+            self.__dict__.pop(attr, None)
+        finals = [self._calibration_run(s, final=True) for s in segments]
+        self.theta0_ = {n: np.mean([f[n][0] for f in finals], axis=0) for n in names}
+        self.cov0_ = {n: np.mean([f[n][1] for f in finals], axis=0) for n in names}
+
+        runs = [self._calibration_run(s, final=False) for s in segments]
+        self.res_mean_, self.res_var_, self.dtheta_cov_, self.dtheta_info_ = {}, {}, {}, {}
+        self.gamma_r_, self.gamma_r_joint_, self.gamma_theta_joint_ = {}, {}, {}
+        for n in names:
+            eps = [r[n][0] for r in runs]
+            dtheta = np.vstack([r[n][1] for r in runs])
+            self.res_mean_[n] = float(np.mean(np.concatenate(eps)))
+            self.res_var_[n] = float(np.var(np.concatenate(eps)))
+            self.dtheta_cov_[n] = np.cov(dtheta, rowvar=False)
+            self.dtheta_info_[n] = np.linalg.pinv(self.dtheta_cov_[n])
+            g = np.concatenate([self._glrt_run(run, n) for run in eps])
+            t = np.einsum("ij,jk,ik->i", dtheta, self.dtheta_info_[n], dtheta)
+            self.gamma_r_[n] = empirical_threshold(g, self.false_alarm)
+            self.gamma_r_joint_[n], self.gamma_theta_joint_[n] = joint_thresholds(
+                g, t, self.false_alarm)
+        return self
+
+    def _glrt_run(self, eps: np.ndarray, name: str) -> np.ndarray:
+        glrt = WindowedGlrt(self._window(), self.res_var_[name]).reset()
+        return np.array([glrt.update(e - self.res_mean_[name]) for e in eps])
+
+    def _calibration_run(self, s: Sampled, final: bool) -> dict:
+        """Per model: final (theta, P) from theta = 0 (``final``), else the armed
+        (residuals, parameter changes) from the a-priori values; no freezing."""
+        self._reset_models(theta0=not final)
+        out = {m["name"]: ([], []) for m in self.models}
+        for x in s.x:
+            for spec, m in zip(self.models, self.models_, strict=True):
+                eps, dtheta = self._model_step(m, x)
+                if dtheta is not None:
+                    out[spec["name"]][0].append(eps)
+                    out[spec["name"]][1].append(dtheta)
+        if final:
+            return {spec["name"]: (m.rls.theta_, m.rls.cov_)
+                    for spec, m in zip(self.models, self.models_, strict=True)}
+        return {n: (np.array(e), np.array(d).reshape(-1, len(self.theta0_[n])))
+                for n, (e, d) in out.items()}
+
+    def fitted(self) -> dict:
+        self._check_fitted("gamma_r_")
+        return {n: {"theta0": self.theta0_[n].tolist(),
+                    "trace_cov0": float(np.trace(self.cov0_[n])),
+                    "residual_mean": self.res_mean_[n], "residual_var": self.res_var_[n],
+                    "gamma_r": self.gamma_r_[n], "gamma_r_joint": self.gamma_r_joint_[n],
+                    "gamma_theta_joint": self.gamma_theta_joint_[n]}
+                for n in self.theta0_}
+
+    # -- streaming ---------------------------------------------------------------------
+
+    def _window(self) -> int:
+        return max(1, round(self.window_s * self.rate_hz))
+
+    def _reset_models(self, theta0: bool) -> None:
+        if not 0.0 < self.forgetting <= 1.0:
+            raise ValueError(f"forgetting must be in (0, 1], got {self.forgetting}")
+        cols = {s: i for i, s in enumerate(self.signals())}
+        self.models_ = [_Model(self, spec, cols) for spec in self.models]
+        for spec, m in zip(self.models, self.models_, strict=True):
+            if theta0:
+                m.rls.reset(self.theta0_[spec["name"]], self.cov0_[spec["name"]])
+            else:
+                m.rls.reset()
+
+    def reset(self) -> FfRlsMonitor:
+        self._check_fitted("gamma_r_")
+        self._reset_models(theta0=True)
+        self.glrt_ = [WindowedGlrt(self._window(), self.res_var_[m["name"]]).reset()
+                      for m in self.models]
+        return self
+
+    def _model_step(self, m: _Model, x: np.ndarray):
+        u = [(x[c] - _PWM_CENTRE_US) / _PWM_HALF_RANGE_US for c in m.u_cols]
+        y = float(x[m.y_col])
+        ar = [m.y_prev] if m.ar else []
+        m.y_prev = y
+        if m.ar and not math.isfinite(ar[0]):
+            return math.nan, None
+        phi = np.array([*u, *ar, 1.0])
+        if m.frozen:
+            eps = y - phi @ m.rls.theta_                   # (14) with theta held
+        else:
+            eps = m.rls.update(phi, y)                     # (14)-(16)
+        m.thetas.append(m.rls.theta_)
+        if len(m.thetas) <= self._window():
+            return eps, None
+        return eps, m.thetas[-1] - m.thetas[0]             # theta(k) - theta(k - M)
+
+    def update(self, x: np.ndarray, fresh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        score = np.full(2 * len(self.models), np.nan)
+        alarm = np.zeros(2 * len(self.models), dtype=bool)
+        for j, (spec, m) in enumerate(zip(self.models, self.models_, strict=True)):
+            n = spec["name"]
+            eps, dtheta = self._model_step(m, x)
+            if dtheta is None:
+                continue
+            g = self.glrt_[j].update(eps - self.res_mean_[n])
+            t = float(dtheta @ self.dtheta_info_[n] @ dtheta)  # T = dtheta' Sigma^-1 dtheta
+            m.frozen = g > self.gamma_r_joint_[n]      # stop adapting while residual test is up
+            joint = min(g / self.gamma_r_joint_[n], t / self.gamma_theta_joint_[n])
+            score[2 * j], score[2 * j + 1] = g, joint
+            alarm[2 * j], alarm[2 * j + 1] = g > self.gamma_r_[n], joint > 1.0
+        return score, alarm
