@@ -6,13 +6,20 @@ A new method is one module defining a :class:`Detector` subclass plus one line i
 
 import inspect
 
-from .base import Detector, Trace, run_detector
+from .base import Detector, NotFittedError, Trace, fault_free_segments, run_detector
+from .ffrls_monitor import FfRlsMonitor
+from .glrt_residuals import GlrtResiduals
+from .kalman_okid import KalmanOkid
 from .rls_arx_zscore import RlsArxZscore
 
-__all__ = ["REGISTRY", "Detector", "Trace", "make_detector", "run_detector"]
+__all__ = ["REGISTRY", "Detector", "NotFittedError", "Trace", "fault_free_segments",
+           "make_detector", "run_detector"]
 
 REGISTRY: dict[str, type[Detector]] = {
     "rls_arx_zscore": RlsArxZscore,
+    "glrt_residuals": GlrtResiduals,
+    "ffrls_monitor": FfRlsMonitor,
+    "kalman_okid": KalmanOkid,
 }
 
 
