@@ -1,9 +1,10 @@
 """Summary and per-fault-class tables, as CSV and Markdown.
 
 ``summary``: one row per (method, subset) with the scoring of
-:func:`~.scoring.summarize`. ``by_fault``: the layout of Keipour et al.'s
-Table I per method and subset: fault class, flights, flight time, mean and max
-detection time, accuracy, and a total row.
+:func:`~.scoring.summarize`. ``comparison``: all methods side by side per subset,
+with the false alarms on fault-free flights and how each was calibrated.
+``by_fault``: the layout of Keipour et al.'s Table I per method and subset: fault
+class, flights, flight time, mean and max detection time, accuracy, and a total row.
 """
 
 from __future__ import annotations
@@ -17,7 +18,8 @@ from alfa_bench.data import subset_flights
 from .reference import ICRA2019_BY_FAULT, ICRA2019_NAME, ICRA2019_SUMMARY
 from .scoring import summarize
 
-__all__ = ["by_fault_markdown", "by_fault_table", "summary_markdown", "summary_table"]
+__all__ = ["by_fault_markdown", "by_fault_table", "comparison_markdown", "comparison_table",
+           "summary_markdown", "summary_table"]
 
 FAULT_ORDER = ("engine", "rudder", "elevator", "aileron", "rudder+aileron", "none")
 
@@ -44,6 +46,31 @@ def summary_table(records: list[dict], manifest: pd.DataFrame, subsets) -> pd.Da
         for method, recs in _records_for(records, manifest, subset).items():
             s = summarize([r["outcome"] for r in recs], [r["detection_s"] for r in recs])
             rows.append({"method": method, "subset": subset, **s})
+    return pd.DataFrame(rows)
+
+
+def _calibration(rec: dict) -> str:
+    cal = rec.get("calibration")
+    return f"leave-one-{cal['group_by']}-out" if cal else "none"
+
+
+def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets) -> pd.DataFrame:
+    """Per subset and method: the scores, false alarms on fault-free flights, and the
+    calibration protocol."""
+    rows = []
+    for subset in subsets:
+        for method, recs in _records_for(records, manifest, subset).items():
+            s = summarize([r["outcome"] for r in recs], [r["detection_s"] for r in recs])
+            free = [r for r in recs if r["fault_class"] == "none"]
+            rows.append({
+                "subset": subset, "method": method, "detector": recs[0]["detector"],
+                "calibration": _calibration(recs[0]), "flights": s["flights"],
+                "precision": s["precision"], "recall": s["recall"], "accuracy": s["accuracy"],
+                "mean_detection_s": s["mean_detection_s"],
+                "max_detection_s": s["max_detection_s"],
+                "fault_free_flights": len(free),
+                "fault_free_false_alarms": sum(r["outcome"] == "FP" for r in free),
+            })
     return pd.DataFrame(rows)
 
 
@@ -126,4 +153,29 @@ def by_fault_markdown(by_fault: pd.DataFrame) -> str:
                         _fmt(ref[4], True)]
             rows.append(row)
         out.append(f"### `{method}` on `{subset}`\n\n" + _markdown(header, rows))
+    return "\n".join(out)
+
+
+def comparison_markdown(comparison: pd.DataFrame) -> str:
+    """One table per subset; the ICRA 2019 paper's row under ``icra22``."""
+    header = ["method", "detector", "calibration", "precision %", "recall %", "accuracy %",
+              "mean det. s", "max det. s", "false alarms, fault-free flights"]
+
+    def cells(r):
+        return [r["method"], r["detector"], r["calibration"], _fmt(r["precision"], True),
+                _fmt(r["recall"], True), _fmt(r["accuracy"], True),
+                _fmt(r["mean_detection_s"]), _fmt(r["max_detection_s"]),
+                f"{r['fault_free_false_alarms']} of {r['fault_free_flights']}"]
+
+    out = []
+    for subset, table in comparison.groupby("subset", sort=False):
+        rows = [cells(r) for r in table.to_dict(orient="records")]
+        if subset == "icra22":
+            paper = ICRA2019_SUMMARY
+            free = ICRA2019_BY_FAULT["none"][0]
+            rows.append(cells({**paper, "method": ICRA2019_NAME, "detector": "rls_arx_zscore",
+                               "calibration": "(as published)", "fault_free_flights": free,
+                               "fault_free_false_alarms": free - paper["tn"]}))
+        flights = int(table["flights"].iloc[0])
+        out.append(f"### Subset `{subset}` ({flights} flights)\n\n" + _markdown(header, rows))
     return "\n".join(out)

@@ -7,6 +7,8 @@ rule tables:
         by_fault="results/tables/by_fault.csv",
         summary_md="results/tables/summary.md",
         by_fault_md="results/tables/by_fault.md",
+        comparison="results/tables/comparison.csv",
+        comparison_md="results/tables/comparison.md",
     params:
         subsets=config["subsets"],
     log:

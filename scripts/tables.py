@@ -1,13 +1,15 @@
-"""Snakemake script: summary and per-fault tables from the detection records."""
+"""Snakemake script: summary, per-fault and comparison tables from the detection records."""
 
 from pathlib import Path
 
 from alfa_bench.analysis import (
-                                 by_fault_markdown,
-                                 by_fault_table,
-                                 read_records,
-                                 summary_markdown,
-                                 summary_table,
+    by_fault_markdown,
+    by_fault_table,
+    comparison_markdown,
+    comparison_table,
+    read_records,
+    summary_markdown,
+    summary_table,
 )
 from alfa_bench.analysis.logs import log_to
 from alfa_bench.data import read_manifest
@@ -18,7 +20,10 @@ manifest = read_manifest(sm.input.manifest)
 records = read_records(sm.input.detections)
 summary = summary_table(records, manifest, sm.params.subsets)
 by_fault = by_fault_table(records, manifest, sm.params.subsets)
+comparison = comparison_table(records, manifest, sm.params.subsets)
 summary.to_csv(sm.output.summary, index=False)
 by_fault.to_csv(sm.output.by_fault, index=False)
+comparison.to_csv(sm.output.comparison, index=False)
 Path(sm.output.summary_md).write_text(summary_markdown(summary))
 Path(sm.output.by_fault_md).write_text(by_fault_markdown(by_fault))
+Path(sm.output.comparison_md).write_text(comparison_markdown(comparison))

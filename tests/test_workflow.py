@@ -50,6 +50,11 @@ def test_outputs_and_their_contents(runs, corpus):
                 "pair_first_alarm_s", "pair_armed_s", "outcome", "provenance"} <= set(r)
         assert r["provenance"]["inputs"]["flight_sha256"]
     assert "Keipour et al. ICRA 2019 (paper)" in (out / "tables/summary.md").read_text()
+    comparison = pd.read_csv(out / "tables/comparison.csv")
+    assert set(comparison["method"]) == set(config["methods"])
+    calibrated = comparison[comparison["calibration"] != "none"]
+    assert set(calibrated["detector"]) == {"glrt_residuals", "ffrls_monitor", "kalman_okid"}
+    assert "Keipour et al. ICRA 2019 (paper)" in (out / "tables/comparison.md").read_text()
     assert (runs[0] / "data/flights.csv").exists()
 
 
