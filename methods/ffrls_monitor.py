@@ -63,7 +63,7 @@ import numpy as np
 from alfa_bench.data import Sampled
 
 from .base import Detector
-from .glrt import WindowedGlrt, empirical_threshold
+from .glrt import WindowedGlrt, empirical_threshold, glrt_statistic
 from .rls import RecursiveLeastSquares
 
 __all__ = ["DEFAULT_MODELS", "FfRlsMonitor", "joint_thresholds"]
@@ -196,8 +196,7 @@ class FfRlsMonitor(Detector):
         return self
 
     def _glrt_run(self, eps: np.ndarray, name: str) -> np.ndarray:
-        glrt = WindowedGlrt(self._window(), self.res_var_[name]).reset()
-        return np.array([glrt.update(e - self.res_mean_[name]) for e in eps])
+        return glrt_statistic(eps - self.res_mean_[name], self._window(), self.res_var_[name])
 
     def _calibration_run(self, s: Sampled, final: bool) -> dict:
         """Per model: final (theta, P) from theta = 0 (``final``), else the armed

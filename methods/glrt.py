@@ -36,7 +36,7 @@ from collections import deque
 import numpy as np
 from scipy import stats
 
-__all__ = ["WindowedGlrt", "chi2_threshold", "empirical_threshold"]
+__all__ = ["WindowedGlrt", "chi2_threshold", "empirical_threshold", "glrt_statistic"]
 
 
 class WindowedGlrt:
@@ -80,6 +80,17 @@ class WindowedGlrt:
         best = int(np.argmax(s))
         self.g_, self.change_, self.mean_ = float(s[best]), best, float(sums[best] / n[best])
         return self.g_
+
+
+def glrt_statistic(x: np.ndarray, window: int, sigma2: float) -> np.ndarray:
+    """:math:`g(k)` for every k of ``x`` at once; what :class:`WindowedGlrt` streams."""
+    x = np.asarray(x, dtype=float)
+    csum = np.r_[0.0, np.cumsum(x)]
+    g = np.zeros(x.size)
+    for n in range(1, min(window, x.size) + 1):            # change instant j = k - n + 1
+        s = csum[n:] - csum[:-n]
+        g[n - 1:] = np.maximum(g[n - 1:], s * s / (2.0 * sigma2 * n))
+    return g
 
 
 def empirical_threshold(g: np.ndarray, false_alarm: float) -> float:

@@ -39,9 +39,9 @@ import numpy as np
 
 from alfa_bench.data import Sampled
 
-from .arx import ArxRegressor, fit_arx
+from .arx import ArxRegressor, arx_regressors, fit_arx
 from .base import Detector
-from .glrt import WindowedGlrt, chi2_threshold, empirical_threshold
+from .glrt import WindowedGlrt, chi2_threshold, empirical_threshold, glrt_statistic
 from .rls_arx_zscore import DEFAULT_PAIRS, RlsArxZscore
 
 __all__ = ["GlrtResiduals"]
@@ -123,10 +123,11 @@ class GlrtResiduals(Detector):
         self.var_ = np.nanvar(pooled, axis=0)
         if self.threshold == "chi2":
             self.threshold_ = np.full(len(self.pairs), chi2_threshold(self.false_alarm))
-        else:
-            g = np.vstack([self._glrt_run(ri) for ri in r])
-            self.threshold_ = np.array([empirical_threshold(g[:, j], self.false_alarm)
-                                        for j in range(len(self.pairs))])
+            return self
+        window = self._window()
+        self.threshold_ = np.array([empirical_threshold(np.concatenate([
+            glrt_statistic(ri[np.isfinite(ri[:, j]), j] - self.mean_[j], window, self.var_[j])
+            for ri in r]), self.false_alarm) for j in range(len(self.pairs))])
         return self
 
     def fitted(self) -> dict:
@@ -138,13 +139,17 @@ class GlrtResiduals(Detector):
         return out
 
     def _residual_run(self, s: Sampled) -> np.ndarray:
+        """Residuals over a segment, NaN where not armed: what :meth:`update` sees."""
+        if self.residuals == "arx":
+            r = np.full((s.t.size, len(self.pairs)), np.nan)
+            start = max(self.na, self._nb() - 1)
+            for j, (iu, iy) in enumerate(self._cols()):
+                phi, y = arx_regressors(s.x[:, iu], s.x[:, iy], self.na, self._nb())
+                r[start:, j] = y - phi @ self.theta_[j]        # r = y - phi' theta
+            return r
         self._reset_residuals()
         return np.array([self._residual_step(x, f) for x, f in zip(s.x, s.fresh, strict=True)]
                         ).reshape(-1, len(self.pairs))
-
-    def _glrt_run(self, r: np.ndarray) -> np.ndarray:
-        self._reset_glrt()
-        return np.array([self._glrt_step(ri) for ri in r]).reshape(-1, len(self.pairs))
 
     # -- streaming ---------------------------------------------------------------------
 
@@ -168,9 +173,15 @@ class GlrtResiduals(Detector):
     def _nb(self) -> int:
         return max(1, round(self.input_window_s * self.rate_hz))
 
-    def _reset_residuals(self) -> None:
+    def _window(self) -> int:
+        return max(1, round(self.window_s * self.rate_hz))
+
+    def _cols(self) -> list[tuple[int, int]]:
         cols = {s: i for i, s in enumerate(self.signals())}
-        self.cols_ = [(cols[p["input"]], cols[p["output"]]) for p in self.pairs]
+        return [(cols[p["input"]], cols[p["output"]]) for p in self.pairs]
+
+    def _reset_residuals(self) -> None:
+        self.cols_ = self._cols()
         if self.residuals == "arx":
             self.arx_ = [ArxRegressor(self.na, self._nb()).reset() for _ in self.pairs]
         else:
@@ -202,14 +213,11 @@ class GlrtResiduals(Detector):
         return r
 
     def _reset_glrt(self) -> None:
-        window = max(1, round(self.window_s * self.rate_hz))
-        var = getattr(self, "var_", np.ones(len(self.pairs)))
-        self.glrt_ = [WindowedGlrt(window, float(v)).reset() for v in var]
+        self.glrt_ = [WindowedGlrt(self._window(), float(v)).reset() for v in self.var_]
 
     def _glrt_step(self, r: np.ndarray) -> np.ndarray:
         g = np.full(len(self.pairs), np.nan)
-        mean = getattr(self, "mean_", np.zeros(len(self.pairs)))
         for j, rj in enumerate(r):
             if math.isfinite(rj):
-                g[j] = self.glrt_[j].update(rj - mean[j])  # x = r - mu0
+                g[j] = self.glrt_[j].update(rj - self.mean_[j])  # x = r - mu0
         return g
