@@ -42,7 +42,7 @@ from alfa_bench.data import Sampled
 from .arx import ArxRegressor, arx_regressors, fit_arx
 from .base import Detector
 from .glrt import WindowedGlrt, chi2_threshold, empirical_threshold, glrt_statistic
-from .rls_arx_zscore import DEFAULT_PAIRS, RlsArxZscore
+from .rls_arx_zscore import DEFAULT_PAIRS, RlsArxZscore, pair_signals
 
 __all__ = ["GlrtResiduals"]
 
@@ -101,7 +101,7 @@ class GlrtResiduals(Detector):
         self.stable_s = stable_s
 
     def signals(self) -> tuple[str, ...]:
-        return tuple(dict.fromkeys(s for p in self.pairs for s in (p["input"], p["output"])))
+        return pair_signals(self.pairs)
 
     def channels(self) -> tuple[str, ...]:
         return tuple(p["name"] for p in self.pairs)

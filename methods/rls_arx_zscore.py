@@ -59,15 +59,15 @@ Choices the paper leaves open, and why these values (none was fitted to scores):
 from __future__ import annotations
 
 import math
-from collections import deque
 
 import numpy as np
 
+from .arx import ArxRegressor
 from .base import Detector
 from .rls import RecursiveLeastSquares
 from .welford import Welford
 
-__all__ = ["DEFAULT_PAIRS", "RlsArxZscore"]
+__all__ = ["DEFAULT_PAIRS", "RlsArxZscore", "pair_signals"]
 
 DEFAULT_PAIRS = (
     {"name": "roll", "input": "roll_cmd", "output": "roll"},
@@ -79,17 +79,20 @@ DEFAULT_PAIRS = (
 _REPEATED = ("hold", "fresh")
 
 
+def pair_signals(pairs) -> tuple[str, ...]:
+    """The signals of input/output ``pairs``, each once, in order of first use."""
+    return tuple(dict.fromkeys(s for p in pairs for s in (p["input"], p["output"])))
+
+
 class _Pair:
     """State of one input/output pair."""
 
     def __init__(self, det: RlsArxZscore, u_col: int, y_col: int):
         self.u_col, self.y_col = u_col, y_col
-        self.nb = max(1, round(det.input_window_s * det.rate_hz))
-        self.na = det.na
-        self.rls = RecursiveLeastSquares(det.na + self.nb, det.p0).reset()
+        nb = max(1, round(det.input_window_s * det.rate_hz))
+        self.regressor = ArxRegressor(det.na, nb).reset()
+        self.rls = RecursiveLeastSquares(det.na + nb, det.p0).reset()
         self.welford = Welford()
-        self.u = deque(maxlen=self.nb)
-        self.y = deque(maxlen=max(det.na, 1))
         self.k = 0                    # grid steps seen
         self.updates = 0              # RLS updates made
         self.streak_from = None       # step where ||L e|| < eps began
@@ -147,7 +150,7 @@ class RlsArxZscore(Detector):
         self.repeated_samples = repeated_samples
 
     def signals(self) -> tuple[str, ...]:
-        return tuple(dict.fromkeys(s for p in self.pairs for s in (p["input"], p["output"])))
+        return pair_signals(self.pairs)
 
     def channels(self) -> tuple[str, ...]:
         return tuple(p["name"] for p in self.pairs)
@@ -178,15 +181,15 @@ class RlsArxZscore(Detector):
     def _step(self, p: _Pair, u: float, y: float, fresh: bool) -> float:
         k = p.k
         p.k += 1
-        p.u.appendleft(u)
+        reg = p.regressor
+        reg.push(u)
         if self.repeated_samples == "fresh" and not fresh:
             return math.nan
-        if len(p.u) < p.nb or len(p.y) < p.na:
-            p.y.appendleft(y)
+        if not reg.ready():
+            reg.push_output(y)
             return math.nan
-        phi = np.fromiter((*list(p.y)[:p.na], *p.u), dtype=float, count=p.na + p.nb)
-        e = p.rls.update(phi, y)
-        p.y.appendleft(y)
+        e = p.rls.update(reg.phi(), y)
+        reg.push_output(y)
         p.updates += 1
 
         if not p.model_stable:
