@@ -15,7 +15,13 @@ from pathlib import Path
 import pandas as pd
 
 from alfa_bench.data import Flight
-from alfa_bench.methods import Detector, fault_free_segments, make_detector, run_detector
+from alfa_bench.methods import (
+    Detector,
+    Trace,
+    fault_free_segments,
+    make_detector,
+    run_detector,
+)
 
 from .calibration import folds
 from .provenance import provenance
@@ -27,9 +33,10 @@ log = logging.getLogger(__name__)
 
 
 def detect_all(method: str, spec: dict, flights: dict[str, Flight], manifest: pd.DataFrame,
-               calibration: dict) -> Iterator[dict]:
-    """Records of ``spec`` (``{"detector": name, "params": {...}}``) on every flight of
-    ``manifest`` with ground truth; ``calibration`` is ``{"group_by", "margin_s"}``."""
+               calibration: dict) -> Iterator[tuple[dict, Trace]]:
+    """Records and traces (with probes) of ``spec`` (``{"detector": name, "params":
+    {...}}``) on every flight of ``manifest`` with ground truth; ``calibration`` is
+    ``{"group_by", "margin_s"}``."""
     detector = make_detector(spec["detector"], spec.get("params"))
     sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
     if not detector.calibrated:
@@ -47,11 +54,12 @@ def detect_all(method: str, spec: dict, flights: dict[str, Flight], manifest: pd
 
 
 def detection_record(method: str, spec: dict, detector: Detector, flight: Flight,
-                     flight_sha256: str, calibration: dict | None = None) -> dict:
-    """Run ``detector`` (fitted if calibrated) on ``flight``."""
+                     flight_sha256: str, calibration: dict | None = None
+                     ) -> tuple[dict, Trace]:
+    """Run ``detector`` (fitted if calibrated) on ``flight``: its record and trace."""
     if flight.fault is None:
         raise ValueError(f"flight {flight.id} has no ground truth and cannot be scored")
-    trace = run_detector(detector, flight)
+    trace = run_detector(detector, flight, probes=True)
     onset = flight.fault.onset_s
     first = trace.first_alarm_s()
     outcome = flight_outcome(onset, first)
@@ -75,7 +83,7 @@ def detection_record(method: str, spec: dict, detector: Detector, flight: Flight
         "repairs": list(flight.repairs),
         "calibration": calibration,
         "provenance": provenance(spec, {"flight_sha256": flight_sha256}),
-    }
+    }, trace
 
 
 def write_record(record: dict, path: Path) -> None:

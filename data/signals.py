@@ -23,7 +23,7 @@ import numpy as np
 from .errors import AlfaDataError
 from .flight import Flight
 
-__all__ = ["SIGNALS", "Sampled", "Signal", "sample"]
+__all__ = ["SIGNALS", "Sampled", "Signal", "sample", "series"]
 
 
 @dataclass(frozen=True)
@@ -93,6 +93,17 @@ class Sampled:
         return Sampled(t=self.t[:n], x=self.x[:n], fresh=self.fresh[:n], names=self.names)
 
 
+def series(flight: Flight, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """Signal ``name`` of ``flight`` at its topic's record times: ``(t, value)``."""
+    if name not in SIGNALS:
+        raise AlfaDataError(f"unknown signal {name!r}; known: {sorted(SIGNALS)}",
+                            flight=flight.id)
+    sig = SIGNALS[name]
+    tp = flight.topic(sig.topic)
+    value = tp.values(sig.column)
+    return tp.t, value - tp.values(sig.minus) if sig.minus else value
+
+
 def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float) -> Sampled:
     """Sample the named signals of ``flight`` at ``rate_hz`` (causal hold)."""
     names = tuple(names)
@@ -111,11 +122,9 @@ def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float) -
     x = np.empty((t.size, len(names)))
     fresh = np.empty((t.size, len(names)), dtype=bool)
     for j, (name, tp) in enumerate(zip(names, topics, strict=True)):
-        sig = SIGNALS[name]
         row = np.searchsorted(tp.t, t, side="right") - 1
-        measured = tp.values(sig.column)
-        value = measured - tp.values(sig.minus) if sig.minus else measured
-        x[:, j] = value[row]
+        measured = tp.values(SIGNALS[name].column)
+        x[:, j] = series(flight, name)[1][row]
         changed = np.r_[True, measured[1:] != measured[:-1]]
         last_change = np.maximum.accumulate(np.where(changed, np.arange(measured.size), 0))
         source = last_change[row]

@@ -3,7 +3,11 @@
 A detector is built from hyper-parameters only; :meth:`Detector.reset` creates its
 learned state (attributes ending in ``_``); :meth:`Detector.update` consumes one
 time step of the signals it asks for and returns, per score channel, the score and
-the alarm of that step. A flight alarms when any channel alarms.
+the alarm of that step. A channel alarms exactly when its score exceeds its
+threshold (:meth:`Detector.thresholds`), so stored scores can be re-thresholded
+without re-running the detector. A flight alarms when any channel alarms.
+:meth:`Detector.probes` exposes the intermediates of the last step (prediction,
+residual, ...) for inspection.
 
 A *calibrated* detector also learns from fault-free data before it runs:
 :meth:`Detector.fit` takes fault-free segments (whole fault-free flights and the
@@ -16,7 +20,7 @@ from __future__ import annotations
 
 import inspect
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -69,6 +73,17 @@ class Detector(ABC):
                                  "fault-free segments before running it")
 
     @abstractmethod
+    def thresholds(self) -> np.ndarray:
+        """Per channel, the threshold :math:`\\gamma_c > 0` in score units: channel
+        :math:`c` alarms when :math:`s_c(k) > \\gamma_c`."""
+
+    def probes(self) -> dict[str, float]:
+        """Intermediates of the last :meth:`update` by name (``"<channel>/prediction"``,
+        ``"<channel>/residual"``, ...; NaN where not computed). Names are fixed after
+        :meth:`reset`. None by default."""
+        return {}
+
+    @abstractmethod
     def reset(self) -> Detector:
         """Forget everything learned while running (not what :meth:`fit` learned);
         return self."""
@@ -94,12 +109,24 @@ class Detector(ABC):
 
 @dataclass(frozen=True)
 class Trace:
-    """A detector's output over a flight, one row per grid step."""
+    """A detector's output over a flight, one row per grid step.
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,)
+    score, alarm : ndarray, shape (n, c)
+    channels : tuple of str
+    threshold : ndarray, shape (c,)
+    probes : dict of str to ndarray, shape (n,)
+        :meth:`Detector.probes` per step, when asked for.
+    """
 
     t: np.ndarray
     score: np.ndarray
     alarm: np.ndarray
     channels: tuple[str, ...]
+    threshold: np.ndarray
+    probes: dict = field(default_factory=dict)
 
     @property
     def any_alarm(self) -> np.ndarray:
@@ -122,16 +149,23 @@ class Trace:
         return [(float(self.t[s]), float(self.t[e - 1])) for s, e in edges.reshape(-1, 2)]
 
 
-def run_detector(detector: Detector, flight: Flight) -> Trace:
-    """Run ``detector`` causally over ``flight``, from a fresh state."""
+def run_detector(detector: Detector, flight: Flight, probes: bool = False) -> Trace:
+    """Run ``detector`` causally over ``flight``, from a fresh state; with ``probes``,
+    keep :meth:`Detector.probes` of every step."""
     s = sample(flight, detector.signals(), detector.rate_hz)
     detector.reset()
     n, c = s.t.size, len(detector.channels())
     score = np.empty((n, c))
     alarm = np.empty((n, c), dtype=bool)
+    names = list(detector.probes()) if probes else []
+    kept = np.full((n, len(names)), np.nan)
     for k in range(n):
         score[k], alarm[k] = detector.update(s.x[k], s.fresh[k])
-    return Trace(t=s.t, score=score, alarm=alarm, channels=detector.channels())
+        if names:
+            kept[k] = list(detector.probes().values())
+    return Trace(t=s.t, score=score, alarm=alarm, channels=detector.channels(),
+                 threshold=np.asarray(detector.thresholds(), dtype=float),
+                 probes={name: kept[:, i] for i, name in enumerate(names)})
 
 
 def fault_free_segments(detector: Detector, flights: list[Flight],

@@ -114,6 +114,7 @@ class _Model:
         self.y_prev = math.nan
         self.thetas = deque(maxlen=det._window() + 1)
         self.frozen = False
+        self.prediction = self.residual = self.change = math.nan  # of the last step
 
 
 class FfRlsMonitor(Detector):
@@ -167,6 +168,18 @@ class FfRlsMonitor(Detector):
 
     def channels(self) -> tuple[str, ...]:
         return tuple(f"{m['name']}_{test}" for m in self.models for test in ("residual", "joint"))
+
+    def thresholds(self) -> np.ndarray:
+        self._check_fitted("gamma_r_")
+        return np.array([g for m in self.models for g in (self.gamma_r_[m["name"]], 1.0)])
+
+    def probes(self) -> dict[str, float]:
+        out = {}
+        for spec, m in zip(self.models, self.models_, strict=True):
+            out[f"{spec['name']}/prediction"] = m.prediction
+            out[f"{spec['name']}/residual"] = m.residual
+            out[f"{spec['name']}/parameter_change"] = m.change
+        return out
 
     # -- calibration -------------------------------------------------------------------
 
@@ -252,6 +265,7 @@ class FfRlsMonitor(Detector):
         y = float(x[m.y_col])
         ar = [m.y_prev] if m.ar else []
         m.y_prev = y
+        m.prediction = m.residual = m.change = math.nan
         if m.ar and not math.isfinite(ar[0]):
             return math.nan, None
         phi = np.array([*u, *ar, 1.0])
@@ -259,6 +273,7 @@ class FfRlsMonitor(Detector):
             eps = y - phi @ m.rls.theta_                   # (14) with theta held
         else:
             eps = m.rls.update(phi, y)                     # (14)-(16)
+        m.prediction, m.residual = y - eps, eps
         m.thetas.append(m.rls.theta_)
         if len(m.thetas) <= self._window():
             return eps, None
@@ -274,6 +289,7 @@ class FfRlsMonitor(Detector):
                 continue
             g = self.glrt_[j].update(eps - self.res_mean_[n])
             t = float(dtheta @ self.dtheta_info_[n] @ dtheta)  # T = dtheta' Sigma^-1 dtheta
+            m.change = t
             m.frozen = g > self.gamma_r_joint_[n]      # stop adapting while residual test is up
             joint = min(g / self.gamma_r_joint_[n], t / self.gamma_theta_joint_[n])
             score[2 * j], score[2 * j + 1] = g, joint

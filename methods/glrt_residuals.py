@@ -78,8 +78,8 @@ class GlrtResiduals(Detector):
         :math:`\\gamma` per pair.
     glrt_ : list of :class:`~.glrt.WindowedGlrt`
         Per-pair test state (``g_``, ``change_``, ``mean_``).
-    residual_ : ndarray
-        The last residual per pair (NaN while not armed).
+    residual_, output_ : ndarray
+        The last residual (NaN while not armed) and output per pair.
     """
 
     calibrated = True
@@ -105,6 +105,17 @@ class GlrtResiduals(Detector):
 
     def channels(self) -> tuple[str, ...]:
         return tuple(p["name"] for p in self.pairs)
+
+    def thresholds(self) -> np.ndarray:
+        self._check_fitted("threshold_")
+        return self.threshold_.copy()
+
+    def probes(self) -> dict[str, float]:
+        out = {}
+        for j, p in enumerate(self.pairs):
+            out[f"{p['name']}/prediction"] = self.output_[j] - self.residual_[j]
+            out[f"{p['name']}/residual"] = self.residual_[j]
+        return out
 
     # -- calibration -------------------------------------------------------------------
 
@@ -191,11 +202,13 @@ class GlrtResiduals(Detector):
                 warmup_samples=self.warmup_samples, eps=self.eps,
                 stable_s=self.stable_s).reset()
         self.residual_ = np.full(len(self.pairs), np.nan)
+        self.output_ = np.full(len(self.pairs), np.nan)
 
     def _residual_step(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:
         r = np.full(len(self.pairs), np.nan)
         for j, (iu, iy) in enumerate(self.cols_):
             u, y = float(x[iu]), float(x[iy])
+            self.output_[j] = y
             if self.residuals == "arx":
                 reg = self.arx_[j]
                 reg.push(u)

@@ -67,6 +67,8 @@ class KalmanOkid(Detector):
         Per output.
     filters_ : list of :class:`~filterpy.kalman.KalmanFilter`
         Per output; ``y`` holds the last innovation, ``K`` the gain.
+    output_, innovation_ : ndarray
+        The last output and innovation per output (NaN while not armed).
     """
 
     calibrated = True
@@ -85,6 +87,17 @@ class KalmanOkid(Detector):
 
     def channels(self) -> tuple[str, ...]:
         return tuple(self.outputs)
+
+    def thresholds(self) -> np.ndarray:
+        self._check_fitted("threshold_")
+        return self.threshold_.copy()
+
+    def probes(self) -> dict[str, float]:
+        out = {}
+        for i, name in enumerate(self.outputs):
+            out[f"{name}/prediction"] = self.output_[i] - self.innovation_[i]
+            out[f"{name}/innovation"] = self.innovation_[i]
+        return out
 
     def _lags(self) -> int:
         return max(1, round(self.lags_s * self.rate_hz))
@@ -141,6 +154,8 @@ class KalmanOkid(Detector):
         self.y_cols_ = [cols[n] for n in self.outputs]
         self.filters_ = [self._filter(m) for m in self.models_]
         self.steps_ = 0
+        self.output_ = np.full(len(self.outputs), np.nan)
+        self.innovation_ = np.full(len(self.outputs), np.nan)
 
     def _innovation_step(self, x: np.ndarray) -> np.ndarray:
         u = x[self.u_cols_]
@@ -151,6 +166,7 @@ class KalmanOkid(Detector):
                 e[i] = kf.y[0, 0]
             kf.predict_steadystate(u.reshape(-1, 1))       # x = A x + B u
         self.steps_ += 1
+        self.output_, self.innovation_ = x[self.y_cols_], e
         return e
 
     def reset(self) -> KalmanOkid:

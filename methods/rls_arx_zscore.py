@@ -100,6 +100,8 @@ class _Pair:
         self.var_from = None          # step where the variance began to hold still
         self.var_stable = False
         self.last_var = math.nan
+        self.prediction = math.nan    # y - e of the last RLS update at this step
+        self.residual = math.nan
 
 
 class RlsArxZscore(Detector):
@@ -155,6 +157,16 @@ class RlsArxZscore(Detector):
     def channels(self) -> tuple[str, ...]:
         return tuple(p["name"] for p in self.pairs)
 
+    def thresholds(self) -> np.ndarray:
+        return np.full(len(self.pairs), float(self.z_threshold))
+
+    def probes(self) -> dict[str, float]:
+        out = {}
+        for spec, p in zip(self.pairs, self.pairs_, strict=True):
+            out[f"{spec['name']}/prediction"] = p.prediction
+            out[f"{spec['name']}/residual"] = p.residual
+        return out
+
     def reset(self) -> RlsArxZscore:
         if self.repeated_samples not in _REPEATED:
             raise ValueError(f"repeated_samples must be one of {_REPEATED}, "
@@ -181,6 +193,7 @@ class RlsArxZscore(Detector):
     def _step(self, p: _Pair, u: float, y: float, fresh: bool) -> float:
         k = p.k
         p.k += 1
+        p.prediction = p.residual = math.nan
         reg = p.regressor
         reg.push(u)
         if self.repeated_samples == "fresh" and not fresh:
@@ -189,6 +202,7 @@ class RlsArxZscore(Detector):
             reg.push_output(y)
             return math.nan
         e = p.rls.update(reg.phi(), y)
+        p.prediction, p.residual = y - e, e
         reg.push_output(y)
         p.updates += 1
 

@@ -2,7 +2,8 @@ rule detect:
     input:
         manifest="data/flights.csv",
     output:
-        directory("results/detections/{method}"),
+        detections=directory("results/detections/{method}"),
+        traces=directory("results/traces/{method}"),
     params:
         spec=lambda w: config["methods"][w.method],
         processed=str(PROCESSED),

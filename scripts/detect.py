@@ -1,21 +1,25 @@
-"""Snakemake script: run one configured method over every flight with ground truth."""
+"""Snakemake script: run one configured method over every flight with ground truth;
+write its detection records and traces."""
 
 import logging
 from pathlib import Path
 
 from alfa_bench.analysis import detect_all, write_record
 from alfa_bench.analysis.logs import log_to
+from alfa_bench.analysis.traces import write_trace
 from alfa_bench.data import load_flight, read_manifest
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 manifest = read_manifest(sm.input.manifest)
-out = Path(sm.output[0])
+out, traces = Path(sm.output.detections), Path(sm.output.traces)
 out.mkdir(parents=True, exist_ok=True)
+traces.mkdir(parents=True, exist_ok=True)
 flights = {name: load_flight(Path(sm.params.processed) / name)
            for name in manifest.loc[manifest["ground_truth"], "flight"]}
-for record in detect_all(sm.wildcards.method, dict(sm.params.spec), flights, manifest,
-                         dict(sm.params.calibration)):
+for record, trace in detect_all(sm.wildcards.method, dict(sm.params.spec), flights, manifest,
+                                dict(sm.params.calibration)):
     write_record(record, out / f"{record['flight']}.json")
+    write_trace(trace, traces / f"{record['flight']}.npz")
     logging.info("%s: %s, first alarm %s", record["flight"], record["outcome"],
                  record["first_alarm_s"])

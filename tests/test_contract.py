@@ -87,6 +87,26 @@ def test_outputs_have_the_declared_shape(detector, one_flight):
     assert np.all(np.diff(trace.t) > 0)
 
 
+def test_alarm_is_score_above_threshold(detector, one_flight):
+    """The contract that lets the threshold sweep re-threshold stored scores."""
+    trace = run_detector(detector, load_flight(one_flight))
+    assert trace.threshold.shape == (len(detector.channels()),)
+    assert np.all(trace.threshold > 0)
+    with np.errstate(invalid="ignore"):
+        np.testing.assert_array_equal(trace.alarm, trace.score > trace.threshold)
+
+
+def test_probes_are_named_once_and_do_not_change_the_run(detector, one_flight):
+    flight = load_flight(one_flight)
+    plain, probed = run_detector(detector, flight), run_detector(detector, flight, probes=True)
+    assert_same(plain, probed)
+    assert plain.probes == {}
+    assert len(probed.probes) == len(set(probed.probes))
+    for name, values in probed.probes.items():
+        assert values.shape == probed.t.shape
+        assert np.isfinite(values).any(), f"probe {name} is never computed"
+
+
 def test_deterministic(detector, one_flight):
     flight = load_flight(one_flight)
     assert_same(run_detector(detector, flight), run_detector(detector, flight))

@@ -42,9 +42,11 @@ def test_onsets_match_the_authors_table(manifest, real_processed):
 
 def test_a_real_flight_gives_a_complete_record(manifest, real_processed):
     row = manifest[manifest["fault_class"] == "engine"].iloc[0]
-    record = detection_record("rls_arx_zscore", {"detector": "rls_arx_zscore"},
-                              make_detector("rls_arx_zscore"),
-                              load_flight(real_processed / row["flight"]), row["sha256"])
+    record, trace = detection_record("rls_arx_zscore", {"detector": "rls_arx_zscore"},
+                                     make_detector("rls_arx_zscore"),
+                                     load_flight(real_processed / row["flight"]),
+                                     row["sha256"])
+    assert record["first_alarm_s"] == trace.first_alarm_s()
     assert record["outcome"] in {"TP", "FP", "FN", "TN", "FP+FN"}
     assert record["grid"]["samples"] > 25 * 60
     assert set(record["pair_first_alarm_s"]) == {"roll", "roll_error", "pitch", "pitch_error"}

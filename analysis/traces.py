@@ -1,0 +1,62 @@
+"""Stored detector traces: what the sweeps, figures and rerun logs read back.
+
+``results/traces/{method}/{flight}.npz`` holds a run's grid times, scores, channel
+thresholds and probes. Alarms are not stored: by the detector contract a channel
+alarms exactly when its score exceeds its threshold. The archive is written with
+fixed member dates, so the same trace gives the same bytes.
+"""
+
+from __future__ import annotations
+
+import io
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+from alfa_bench.methods import Trace
+
+__all__ = ["read_trace", "read_traces", "write_trace"]
+
+_EPOCH = (1980, 1, 1, 0, 0, 0)  # the earliest date a zip member can carry
+
+
+def write_trace(trace: Trace, path: str | Path) -> None:
+    """Write ``trace`` to ``path`` (an ``.npz`` that :func:`numpy.load` reads)."""
+    names = list(trace.probes)
+    arrays = {
+        "t": trace.t,
+        "score": trace.score,
+        "threshold": trace.threshold,
+        "channels": np.array(trace.channels, dtype=str),
+        "probe_names": np.array(names, dtype=str),
+        "probes": (np.column_stack([trace.probes[n] for n in names]) if names
+                   else np.empty((trace.t.size, 0))),
+    }
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+        for name, a in arrays.items():
+            buf = io.BytesIO()
+            np.lib.format.write_array(buf, np.ascontiguousarray(a), allow_pickle=False)
+            info = zipfile.ZipInfo(f"{name}.npy", date_time=_EPOCH)
+            info.compress_type = zipfile.ZIP_DEFLATED
+            z.writestr(info, buf.getvalue())
+
+
+def read_trace(path: str | Path) -> Trace:
+    """The :class:`~alfa_bench.methods.Trace` stored at ``path``, alarms included."""
+    with np.load(path, allow_pickle=False) as z:
+        score, threshold = z["score"], z["threshold"]
+        with np.errstate(invalid="ignore"):
+            alarm = score > threshold
+        probes = z["probes"]
+        return Trace(t=z["t"], score=score, alarm=alarm,
+                     channels=tuple(str(c) for c in z["channels"]), threshold=threshold,
+                     probes={str(n): probes[:, i] for i, n in enumerate(z["probe_names"])})
+
+
+def read_traces(folders) -> dict[tuple[str, str], Trace]:
+    """Every trace in the given ``results/traces/{method}`` folders, by (method, flight)."""
+    return {(Path(d).name, p.stem): read_trace(p)
+            for d in folders for p in sorted(Path(d).glob("*.npz"))}
