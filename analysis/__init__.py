@@ -4,14 +4,18 @@ from .calibration import folds
 from .detections import detect_all, detection_record, read_records, write_record
 from .scoring import OUTCOMES, flight_outcome, summarize
 from .tables import (
+    by_fault_latex,
     by_fault_markdown,
     by_fault_table,
+    comparison_latex,
     comparison_markdown,
     comparison_table,
+    summary_latex,
     summary_markdown,
     summary_table,
 )
 
-__all__ = ["OUTCOMES", "by_fault_markdown", "by_fault_table", "comparison_markdown",
-           "comparison_table", "detect_all", "detection_record", "flight_outcome", "folds",
-           "read_records", "summarize", "summary_markdown", "summary_table", "write_record"]
+__all__ = ["OUTCOMES", "by_fault_latex", "by_fault_markdown", "by_fault_table",
+           "comparison_latex", "comparison_markdown", "comparison_table", "detect_all",
+           "detection_record", "flight_outcome", "folds", "read_records", "summarize",
+           "summary_latex", "summary_markdown", "summary_table", "write_record"]

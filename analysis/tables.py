@@ -1,8 +1,9 @@
-"""Summary and per-fault-class tables, as CSV and Markdown.
+"""Summary and per-fault-class tables, as CSV, Markdown and LaTeX.
 
 ``summary``: one row per (method, subset) with the scoring of
 :func:`~.scoring.summarize`. ``comparison``: all methods side by side per subset,
-with the false alarms on fault-free flights and how each was calibrated.
+with the false alarms on fault-free flights, how each was calibrated, and on how many
+flights it armed (judged at all: a method that never arms has no false alarms).
 ``by_fault``: the layout of Keipour et al.'s Table I per method and subset: fault
 class, flights, flight time, mean and max detection time, accuracy, and a total row.
 """
@@ -18,8 +19,9 @@ from alfa_bench.data import subset_flights
 from .reference import ICRA2019_BY_FAULT, ICRA2019_NAME, ICRA2019_SUMMARY
 from .scoring import summarize
 
-__all__ = ["by_fault_markdown", "by_fault_table", "comparison_markdown", "comparison_table",
-           "summary_markdown", "summary_table"]
+__all__ = ["FAULT_ORDER", "by_fault_latex", "by_fault_markdown", "by_fault_table",
+           "comparison_latex", "comparison_markdown", "comparison_table", "latex_escape",
+           "summary_latex", "summary_markdown", "summary_table"]
 
 FAULT_ORDER = ("engine", "rudder", "elevator", "aileron", "rudder+aileron", "none")
 
@@ -70,6 +72,8 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets) -> pd
                 "max_detection_s": s["max_detection_s"],
                 "fault_free_flights": len(free),
                 "fault_free_false_alarms": sum(r["outcome"] == "FP" for r in free),
+                "armed_flights": sum(any(v is not None for v in r["pair_armed_s"].values())
+                                     for r in recs),
             })
     return pd.DataFrame(rows)
 
@@ -106,14 +110,50 @@ def _fmt(v, pct=False, digits=2) -> str:
     return str(v)
 
 
-def _markdown(header: list[str], rows: list[list[str]]) -> str:
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(r) + " |" for r in rows]
-    return "\n".join(lines) + "\n"
+Section = tuple[str, list[str], list[list[str]]]  # title (`code` marked), header, rows
 
 
-def summary_markdown(summary: pd.DataFrame) -> str:
-    """Per subset, a table of methods, with the paper's row under ``icra22``."""
+def _markdown(sections: list[Section]) -> str:
+    out = []
+    for title, header, rows in sections:
+        lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+        lines += ["| " + " | ".join(r) + " |" for r in rows]
+        out.append(f"### {title}\n\n" + "\n".join(lines) + "\n")
+    return "\n".join(out)
+
+
+_LATEX_ESCAPES = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$",
+                  "#": r"\#", "_": r"\_", "{": r"\{", "}": r"\}", "~": r"\textasciitilde{}",
+                  "^": r"\textasciicircum{}"}
+
+
+def latex_escape(text: str) -> str:
+    """Escape ``text`` for LaTeX; `code` becomes \\texttt{code}."""
+    parts = text.split("`")
+    esc = ["".join(_LATEX_ESCAPES.get(ch, ch) for ch in part) for part in parts]
+    return "".join(rf"\texttt{{{e}}}" if i % 2 else e for i, e in enumerate(esc))
+
+
+_SHRINK = r"\resizebox{\ifdim\width>\linewidth\linewidth\else\width\fi}{!}{%"
+
+
+def _latex(sections: list[Section], label: str) -> str:
+    """One booktabs table float per section, labelled ``tab:<label>-<1, 2, ...>``, shrunk
+    to the line width where wider (needs the graphicx and booktabs packages)."""
+    out = []
+    for i, (title, header, rows) in enumerate(sections, 1):
+        spec = "l" * 3 + "r" * (len(header) - 3) if len(header) > 3 else "l" * len(header)
+        lines = [r"\begin{table}[htbp]", r"\centering", r"\scriptsize",
+                 rf"\caption{{{latex_escape(title)}}}\label{{tab:{label}-{i}}}", _SHRINK,
+                 rf"\begin{{tabular}}{{{spec}}}", r"\toprule",
+                 " & ".join(latex_escape(h) for h in header) + r" \\", r"\midrule"]
+        lines += [" & ".join(latex_escape(c) for c in r) + r" \\" for r in rows]
+        lines += [r"\bottomrule", r"\end{tabular}}", r"\end{table}"]
+        out.append("\n".join(lines) + "\n")
+    return "\n".join(out)
+
+
+def _summary_sections(summary: pd.DataFrame) -> list[Section]:
     header = ["method", "flights", "TP", "FP", "FN", "TN", "precision %", "recall %",
               "accuracy %", "mean det. s", "max det. s"]
 
@@ -128,12 +168,11 @@ def summary_markdown(summary: pd.DataFrame) -> str:
         rows = [cells(r["method"], r) for r in table.to_dict(orient="records")]
         if subset == "icra22":
             rows.append(cells(ICRA2019_NAME, ICRA2019_SUMMARY))
-        out.append(f"### Subset `{subset}`\n\n" + _markdown(header, rows))
-    return "\n".join(out)
+        out.append((f"Subset `{subset}`", header, rows))
+    return out
 
 
-def by_fault_markdown(by_fault: pd.DataFrame) -> str:
-    """Per method and subset, Table I's layout; the paper's values beside ``icra22``."""
+def _by_fault_sections(by_fault: pd.DataFrame) -> list[Section]:
     out = []
     for (method, subset), table in by_fault.groupby(["method", "subset"], sort=False):
         paper = subset == "icra22"
@@ -152,20 +191,21 @@ def by_fault_markdown(by_fault: pd.DataFrame) -> str:
                 row += [_fmt(ref[0]), _fmt(ref[1]), _fmt(ref[2]), _fmt(ref[3]),
                         _fmt(ref[4], True)]
             rows.append(row)
-        out.append(f"### `{method}` on `{subset}`\n\n" + _markdown(header, rows))
-    return "\n".join(out)
+        out.append((f"`{method}` on `{subset}`", header, rows))
+    return out
 
 
-def comparison_markdown(comparison: pd.DataFrame) -> str:
-    """One table per subset; the ICRA 2019 paper's row under ``icra22``."""
+def _comparison_sections(comparison: pd.DataFrame) -> list[Section]:
     header = ["method", "detector", "calibration", "precision %", "recall %", "accuracy %",
-              "mean det. s", "max det. s", "false alarms, fault-free flights"]
+              "mean det. s", "max det. s", "false alarms, fault-free flights",
+              "flights armed"]
 
     def cells(r):
         return [r["method"], r["detector"], r["calibration"], _fmt(r["precision"], True),
                 _fmt(r["recall"], True), _fmt(r["accuracy"], True),
                 _fmt(r["mean_detection_s"]), _fmt(r["max_detection_s"]),
-                f"{r['fault_free_false_alarms']} of {r['fault_free_flights']}"]
+                f"{r['fault_free_false_alarms']} of {r['fault_free_flights']}",
+                _fmt(r.get("armed_flights"))]
 
     out = []
     for subset, table in comparison.groupby("subset", sort=False):
@@ -175,7 +215,38 @@ def comparison_markdown(comparison: pd.DataFrame) -> str:
             free = ICRA2019_BY_FAULT["none"][0]
             rows.append(cells({**paper, "method": ICRA2019_NAME, "detector": "rls_arx_zscore",
                                "calibration": "(as published)", "fault_free_flights": free,
-                               "fault_free_false_alarms": free - paper["tn"]}))
+                               "fault_free_false_alarms": free - paper["tn"],
+                               "armed_flights": None}))
         flights = int(table["flights"].iloc[0])
-        out.append(f"### Subset `{subset}` ({flights} flights)\n\n" + _markdown(header, rows))
-    return "\n".join(out)
+        out.append((f"Subset `{subset}` ({flights} flights)", header, rows))
+    return out
+
+
+def summary_markdown(summary: pd.DataFrame) -> str:
+    """Per subset, a table of methods, with the paper's row under ``icra22``."""
+    return _markdown(_summary_sections(summary))
+
+
+def summary_latex(summary: pd.DataFrame) -> str:
+    """:func:`summary_markdown` as LaTeX (booktabs)."""
+    return _latex(_summary_sections(summary), "summary")
+
+
+def by_fault_markdown(by_fault: pd.DataFrame) -> str:
+    """Per method and subset, Table I's layout; the paper's values beside ``icra22``."""
+    return _markdown(_by_fault_sections(by_fault))
+
+
+def by_fault_latex(by_fault: pd.DataFrame) -> str:
+    """:func:`by_fault_markdown` as LaTeX (booktabs)."""
+    return _latex(_by_fault_sections(by_fault), "by-fault")
+
+
+def comparison_markdown(comparison: pd.DataFrame) -> str:
+    """One table per subset; the ICRA 2019 paper's row under ``icra22``."""
+    return _markdown(_comparison_sections(comparison))
+
+
+def comparison_latex(comparison: pd.DataFrame) -> str:
+    """:func:`comparison_markdown` as LaTeX (booktabs)."""
+    return _latex(_comparison_sections(comparison), "comparison")

@@ -5,10 +5,13 @@ rule tables:
     output:
         summary="results/tables/summary.csv",
         by_fault="results/tables/by_fault.csv",
+        comparison=report("results/tables/comparison.csv", category="Tables"),
         summary_md="results/tables/summary.md",
         by_fault_md="results/tables/by_fault.md",
-        comparison="results/tables/comparison.csv",
         comparison_md="results/tables/comparison.md",
+        summary_tex="results/tables/summary.tex",
+        by_fault_tex="results/tables/by_fault.tex",
+        comparison_tex="results/tables/comparison.tex",
     params:
         subsets=config["subsets"],
     log:

@@ -1,13 +1,16 @@
-"""Snakemake script: summary, per-fault and comparison tables from the detection records."""
+"""Snakemake script: summary, per-fault and comparison tables (CSV, Markdown, LaTeX)."""
 
 from pathlib import Path
 
 from alfa_bench.analysis import (
+    by_fault_latex,
     by_fault_markdown,
     by_fault_table,
+    comparison_latex,
     comparison_markdown,
     comparison_table,
     read_records,
+    summary_latex,
     summary_markdown,
     summary_table,
 )
@@ -27,3 +30,6 @@ comparison.to_csv(sm.output.comparison, index=False)
 Path(sm.output.summary_md).write_text(summary_markdown(summary))
 Path(sm.output.by_fault_md).write_text(by_fault_markdown(by_fault))
 Path(sm.output.comparison_md).write_text(comparison_markdown(comparison))
+Path(sm.output.summary_tex).write_text(summary_latex(summary))
+Path(sm.output.by_fault_tex).write_text(by_fault_latex(by_fault))
+Path(sm.output.comparison_tex).write_text(comparison_latex(comparison))
