@@ -10,7 +10,7 @@ from pathlib import Path
 __all__ = ["PACKAGES", "code_version", "package_versions", "provenance"]
 
 PACKAGES = ("alfa-bench", "numpy", "scipy", "pandas", "filterpy", "control", "scikit-learn",
-            "rerun-sdk", "snakemake")
+            "rerun-sdk", "snakemake", "matplotlib")
 
 
 @cache

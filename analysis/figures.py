@@ -1,0 +1,146 @@
+"""Comparison figures, drawn from detection records, stored traces and sweeps.
+
+- :func:`sweep_figure`: detection rate against false alarms (per flight and per hour
+  of fault-free flight) and mean detection time against false alarms per hour, every
+  method on one set of axes, the configured operating point marked.
+- :func:`detection_time_figure`: per method, detection times by fault class.
+- :func:`flight_figure`: per flight, one small panel per method of its score-to-
+  threshold ratio around the onset.
+
+PNG output is deterministic for a given matplotlib version (no dates are written).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from alfa_bench.methods import Trace  # noqa: E402
+
+from .sweep import ratio  # noqa: E402
+from .tables import FAULT_ORDER  # noqa: E402
+
+__all__ = ["detection_time_figure", "flight_figure", "sweep_figure"]
+
+_DPI = 110
+_METADATA = {"Software": None}
+
+
+def _colors(methods) -> dict[str, tuple]:
+    cmap = plt.get_cmap("tab10")
+    return {m: cmap(i % 10) for i, m in enumerate(methods)}
+
+
+def _save(fig, path: str | Path) -> None:
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=_DPI, metadata=_METADATA)
+    plt.close(fig)
+
+
+def sweep_figure(sweep: pd.DataFrame, subset: str, path: str | Path) -> None:
+    """Three panels over the threshold scale, for ``subset`` of ``sweep``
+    (:func:`~.sweep.sweep_table`). Each curve is traced in the order of the scale; it
+    need not be monotone, since a lower threshold can turn a detection into an alarm
+    before onset."""
+    data = sweep[sweep["subset"] == subset]
+    methods = list(dict.fromkeys(data["method"]))
+    colors = _colors(methods)
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), layout="constrained")
+    panels = [
+        ("false_alarm_flights", "recall", "flights with a false alarm (share)",
+         "detection rate (recall)", "linear"),
+        ("false_alarms_per_hour", "recall", "false alarms per hour of fault-free flight",
+         "detection rate (recall)", "symlog"),
+        ("false_alarms_per_hour", "mean_detection_s",
+         "false alarms per hour of fault-free flight", "mean detection time (s)", "symlog"),
+    ]
+    for ax, (x, y, xlabel, ylabel, xscale) in zip(axes, panels, strict=True):
+        for m in methods:
+            d = data[data["method"] == m].sort_values("scale")
+            ax.plot(d[x], d[y], color=colors[m], lw=1.2, label=m, alpha=0.9)
+            at = d[d["scale"] == 1.0]
+            ax.plot(at[x], at[y], "o", color=colors[m], ms=6, mec="black", mew=0.6)
+        ax.set_xscale(xscale, **({"linthresh": 1.0} if xscale == "symlog" else {}))
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+        ax.grid(alpha=0.3)
+    axes[0].set_xlim(-0.02, 1.02)
+    axes[0].set_ylim(-0.02, 1.02)
+    axes[1].set_ylim(-0.02, 1.02)
+    axes[0].legend(fontsize=8, loc="lower right")
+    n = int(data["flights"].iloc[0]) if len(data) else 0
+    fig.suptitle(f"Threshold sweep, subset '{subset}' ({n} flights): every channel "
+                 "threshold scaled by one factor; dots = configured thresholds")
+    _save(fig, path)
+
+
+def detection_time_figure(records: list[dict], flights: list[str], path: str | Path) -> None:
+    """Per method, the detection time of each detected fault, by fault class, over
+    ``flights``; each class is labelled with detected / flights."""
+    methods = list(dict.fromkeys(r["method"] for r in records))
+    keep = set(flights)
+    classes = [c for c in FAULT_ORDER if c != "none" and any(
+        r["fault_class"] == c and r["flight"] in keep for r in records)]
+    cols = min(4, len(methods))
+    rows = -(-len(methods) // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(3.6 * cols, 3.0 * rows), squeeze=False,
+                             sharey=True, layout="constrained")
+    for ax, m in zip(axes.flat, methods, strict=False):
+        recs = [r for r in records if r["method"] == m and r["flight"] in keep]
+        labels = []
+        for i, c in enumerate(classes):
+            rc = [r for r in recs if r["fault_class"] == c]
+            times = np.array([r["detection_s"] for r in rc if r["outcome"] == "TP"])
+            jitter = (np.arange(times.size) % 5 - 2) * 0.06
+            ax.plot(i + jitter, times, "o", ms=4, alpha=0.8)
+            if times.size:
+                ax.hlines(np.median(times), i - 0.3, i + 0.3, color="black", lw=1.2)
+            labels.append(f"{c}\n{times.size}/{len(rc)}")
+        ax.set_xticks(range(len(classes)), labels, fontsize=7)
+        ax.set_title(m, fontsize=9)
+        ax.grid(alpha=0.3, axis="y")
+    for ax in axes.flat[len(methods):]:
+        ax.set_visible(False)
+    for ax in axes[:, 0]:
+        ax.set_ylabel("detection time (s)")
+    fig.suptitle("Detection time by fault class (bar = median; label = detected / flights)")
+    _save(fig, path)
+
+
+def flight_figure(flight: str, onset_s: float | None, end_s: float | None,
+                  traces: dict[str, Trace], path: str | Path, window_s: float = 30.0) -> None:
+    """One panel per method: :math:`\\max_c s_c/\\gamma_c` against the threshold 1,
+    within ``window_s`` of the onset (the whole flight if fault-free)."""
+    methods = list(traces)
+    fig, axes = plt.subplots(len(methods), 1, figsize=(8, 1.25 * len(methods) + 0.8),
+                             sharex=True, squeeze=False, layout="constrained")
+    for ax, m in zip(axes[:, 0], methods, strict=True):
+        tr = traces[m]
+        r = ratio(tr)
+        lo, hi = ((tr.t[0], tr.t[-1]) if onset_s is None
+                  else (onset_s - window_s, min(onset_s + window_s, tr.t[-1])))
+        sel = (tr.t >= lo) & (tr.t <= hi) & np.isfinite(r)
+        ax.plot(tr.t[sel], np.clip(r[sel], 1e-2, 1e4), lw=0.9, color="tab:blue")
+        ax.axhline(1.0, color="tab:red", lw=0.9, ls="--")
+        if onset_s is not None:
+            ax.axvspan(onset_s, min(hi, end_s if end_s is not None else hi), color="0.85")
+        first = tr.first_alarm_s()
+        if first is not None and lo <= first <= hi:
+            ax.axvline(first, color="tab:red", lw=1.2)
+        note = "no alarm" if first is None else f"first alarm {first:.1f} s"
+        ax.text(0.005, 0.95, note, transform=ax.transAxes, fontsize=7, va="top")
+        ax.set_yscale("log")
+        ax.set_ylim(1e-2, 1e4)
+        ax.set_xlim(lo, hi)
+        ax.set_ylabel(m, fontsize=7, rotation=0, ha="right", va="center")
+        ax.tick_params(labelsize=7)
+    axes[-1, 0].set_xlabel("flight time (s)")
+    fig.suptitle(f"{flight}\nscore / threshold (dashed: alarm level; grey: fault; "
+                 "red line: first alarm)", fontsize=9)
+    _save(fig, path)

@@ -1,0 +1,48 @@
+rule sweep:
+    input:
+        manifest="data/flights.csv",
+        detections=expand("results/detections/{method}", method=METHODS),
+        traces=expand("results/traces/{method}", method=METHODS),
+    output:
+        report("results/tables/sweep.csv", category="Threshold sweeps"),
+    params:
+        subsets=config["subsets"],
+    log:
+        "results/logs/sweep.log",
+    script:
+        "../scripts/sweep.py"
+
+
+rule figures:
+    input:
+        manifest="data/flights.csv",
+        sweep="results/tables/sweep.csv",
+        detections=expand("results/detections/{method}", method=METHODS),
+        traces=expand("results/traces/{method}", method=METHODS),
+    output:
+        sweep=report("results/figures/sweep.png", caption="../report/sweep.rst",
+                     category="Threshold sweeps"),
+        detection_time=report("results/figures/detection_time.png",
+                              caption="../report/detection_time.rst",
+                              category="Detection times"),
+        flights=report(directory("results/figures/flights"), patterns=["{flight}.png"],
+                       caption="../report/flight.rst", category="Flights"),
+    params:
+        subset=config["figures"]["subset"],
+    log:
+        "results/logs/figures.log",
+    script:
+        "../scripts/figures.py"
+
+
+# The README shows the sweep of the last run; the copy is tracked, so a change of
+# results shows in `git diff`.
+rule readme_figure:
+    input:
+        "results/figures/sweep.png",
+    output:
+        "paper/figures/sweep.png",
+    log:
+        "results/logs/readme_figure.log",
+    shell:
+        "cp {input} {output} 2> {log}"

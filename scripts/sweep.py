@@ -1,0 +1,13 @@
+"""Snakemake script: threshold sweeps of every method from its stored traces."""
+
+from alfa_bench.analysis import read_records
+from alfa_bench.analysis.logs import log_to
+from alfa_bench.analysis.sweep import sweep_table
+from alfa_bench.analysis.traces import read_traces
+from alfa_bench.data import read_manifest
+
+sm = snakemake  # noqa: F821
+log_to(sm.log[0])
+sweep = sweep_table(read_records(sm.input.detections), read_traces(sm.input.traces),
+                    read_manifest(sm.input.manifest), sm.params.subsets)
+sweep.to_csv(sm.output[0], index=False)
