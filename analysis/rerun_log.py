@@ -1,0 +1,141 @@
+"""One rerun recording per flight: signals, every method's scores and intermediates.
+
+Open one with ``rerun results/rerun/<flight>.rrd``. Everything is on the
+``flight_time`` timeline (seconds on the flight clock); the recording id is the
+flight's name, and no wall-clock time is logged, so the same inputs give the same
+entities, times and values (rerun's own row and chunk ids are time-based, so the
+bytes differ between writes).
+
+Entities
+--------
+``signals/<group>/<signal>``
+    The raw input/output signals of every method, at their topics' record times
+    (groups: attitude, attitude_error, rates, servos, airspeed).
+``methods/<method>/scores/<channel>/{score,threshold}``
+    Each channel's score and its threshold.
+``methods/<method>/probes/<probe>``
+    The method's intermediates: prediction, residual (innovation), parameter change.
+``overview/<method>``
+    :math:`\\max_c s_c/\\gamma_c`: above 1 the method alarms.
+``events``
+    Fault onset and end, and the start of every alarm of every method.
+Recording property ``flight``: fault class, onset, end, date, label and the code
+version that wrote the file.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import rerun as rr
+import rerun.blueprint as rrb
+
+from alfa_bench.data import SIGNALS, Flight, series
+from alfa_bench.methods import Trace
+
+from .provenance import code_version
+from .sweep import ratio
+
+__all__ = ["TIMELINE", "blueprint", "signal_group", "write_rerun_log"]
+
+TIMELINE = "flight_time"
+_APPLICATION = "alfa-bench"
+_GROUPS = ("attitude", "attitude_error", "rates", "servos", "airspeed")
+_RED = (220, 40, 40)
+
+
+def signal_group(name: str) -> str:
+    """The view a signal is drawn in."""
+    sig = SIGNALS[name]
+    if sig.unit == "deg":
+        return "attitude_error" if sig.minus else "attitude"
+    return {"rad/s": "rates", "us": "servos", "m/s": "airspeed"}[sig.unit]
+
+
+def blueprint(methods: list[str], groups: list[str]) -> rrb.Blueprint:
+    """Signals on top, all methods' score/threshold with the event log in the middle,
+    one tab per method with its scores and intermediates below."""
+    signals = rrb.Horizontal(*[rrb.TimeSeriesView(origin=f"/signals/{g}", name=g)
+                               for g in groups])
+    overview = rrb.Horizontal(
+        rrb.TimeSeriesView(origin="/overview", name="score / threshold (alarm above 1)",
+                           axis_y=rrb.ScalarAxis(range=(0.0, 3.0))),
+        rrb.TextLogView(origin="/events", name="events"),
+        column_shares=[3, 2])
+    tabs = rrb.Tabs(*[rrb.Horizontal(
+        rrb.TimeSeriesView(origin=f"/methods/{m}/scores", name=f"{m}: scores, thresholds"),
+        rrb.TimeSeriesView(origin=f"/methods/{m}/probes", name=f"{m}: intermediates"),
+        name=m) for m in methods])
+    return rrb.Blueprint(rrb.Vertical(signals, overview, tabs, row_shares=[2, 2, 3]),
+                         collapse_panels=True)
+
+
+def _series(rec: rr.RecordingStream, path: str, t: np.ndarray, v: np.ndarray, name: str,
+            color=None, step: bool = False) -> None:
+    keep = np.isfinite(v)
+    if not keep.any():
+        return
+    rec.log(path, rr.SeriesLines(names=name, colors=color,
+                                 interpolation_mode="StepAfter" if step else None),
+            static=True)
+    rec.send_columns(path, indexes=[rr.TimeColumn(TIMELINE, duration=t[keep])],
+                     columns=rr.Scalars.columns(scalars=v[keep]))
+
+
+def _events(flight: Flight, traces: dict[str, Trace]) -> list[tuple[float, str, str]]:
+    events = []
+    if flight.fault.onset_s is not None:
+        events.append((flight.fault.onset_s, f"fault onset: {flight.fault.fault_class}",
+                       "WARN"))
+        events.append((flight.fault.end_s, "fault end", "INFO"))
+    for method, tr in traces.items():
+        for start, stop in tr.alarm_intervals():
+            k = int(np.searchsorted(tr.t, start))
+            channels = [c for c, a in zip(tr.channels, tr.alarm[k], strict=True) if a]
+            events.append((start, f"alarm {method} ({', '.join(channels)}) until {stop:.2f} s",
+                           "ERROR"))
+    return sorted(events, key=lambda e: (e[0], e[1]))
+
+
+def write_rerun_log(flight: Flight, traces: dict[str, Trace], signals: list[str],
+                    path: str | Path) -> None:
+    """Write the recording of ``flight`` with the ``traces`` of each method (with
+    probes) and the raw ``signals`` to ``path``."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    groups = [g for g in _GROUPS if any(signal_group(s) == g for s in signals)]
+    rec = rr.RecordingStream(_APPLICATION, recording_id=flight.id, send_properties=False)
+    rec.save(path, default_blueprint=blueprint(list(traces), groups))
+    rec.send_recording_name(flight.id)
+    fault = flight.fault
+    rec.send_property("flight", rr.AnyValues(
+        flight=flight.id, date=flight.date, label=flight.label,
+        fault_class=fault.fault_class if fault else "unknown",
+        onset_s=np.nan if fault is None or fault.onset_s is None else fault.onset_s,
+        fault_end_s=np.nan if fault is None or fault.end_s is None else fault.end_s,
+        git_commit=code_version()["git_commit"] or "unknown"))
+
+    for s in signals:
+        t, v = series(flight, s)
+        _series(rec, f"signals/{signal_group(s)}/{s}", t, v, s, step=True)
+    for method, tr in traces.items():
+        base = f"methods/{method}"
+        for c, channel in enumerate(tr.channels):
+            _series(rec, f"{base}/scores/{channel}/score", tr.t, tr.score[:, c], channel)
+            _series(rec, f"{base}/scores/{channel}/threshold", tr.t[[0, -1]],
+                    np.full(2, tr.threshold[c]), f"{channel} threshold", _RED)
+        for probe, values in tr.probes.items():
+            _series(rec, f"{base}/probes/{probe}", tr.t, values, probe)
+        r = ratio(tr)
+        _series(rec, f"overview/{method}", tr.t, np.where(np.isinf(r), np.nan, r), method)
+    _series(rec, "overview/threshold", np.array([0.0, flight.duration_s]), np.ones(2),
+            "alarm level", _RED)
+
+    events = _events(flight, traces) if fault else []
+    if events:
+        times, texts, levels = zip(*events, strict=True)
+        rec.send_columns("events", indexes=[rr.TimeColumn(TIMELINE, duration=list(times))],
+                         columns=rr.TextLog.columns(text=list(texts), level=list(levels)))
+    rec.flush()
+    rec.disconnect()

@@ -1,0 +1,23 @@
+"""Snakemake script: one rerun recording per flight with every method's traces."""
+
+import logging
+from pathlib import Path
+
+from alfa_bench.analysis.logs import log_to
+from alfa_bench.analysis.rerun_log import write_rerun_log
+from alfa_bench.analysis.traces import read_traces
+from alfa_bench.data import load_flight, read_manifest
+from alfa_bench.methods import make_detector
+
+sm = snakemake  # noqa: F821
+log_to(sm.log[0])
+manifest = read_manifest(sm.input.manifest)
+specs = dict(sm.params.methods)
+detectors = [make_detector(spec["detector"], spec.get("params")) for spec in specs.values()]
+signals = list(dict.fromkeys(s for d in detectors for s in d.signals()))
+traces = read_traces(sm.input.traces)
+out = Path(sm.output[0])
+for flight in manifest.loc[manifest["ground_truth"], "flight"]:
+    write_rerun_log(load_flight(Path(sm.params.processed) / flight),
+                    {m: traces[m, flight] for m in specs}, signals, out / f"{flight}.rrd")
+    logging.info("%s: written", flight)
