@@ -15,8 +15,18 @@ include: "rules/common.smk"
 include: "rules/data.smk"
 include: "rules/detect.smk"
 include: "rules/tables.smk"
+include: "rules/sweep.smk"
+include: "rules/rerun.smk"
+include: "rules/paper.smk"
 
 
 rule all:
     input:
         rules.tables.output,
+        rules.sweep.output,
+        rules.figures.output,
+        rules.readme_figure.output,
+        rules.rerun_logs.output,
+        rules.paper_sources.output,
+        # the PDF where a LaTeX engine (latexmk + pdflatex) is installed
+        rules.paper_pdf.output if LATEX else [],

@@ -1,0 +1,102 @@
+"""The numbers the manuscript quotes, and its Markdown twin rendered from them.
+
+The LaTeX manuscript (``paper/paper.tex``) and its Markdown twin
+(``paper/paper.template.md``) quote results only by key: ``\\result{key}`` and
+``{{num:key}}``, defined here from the workflow's tables. Tables and figures are
+included from the files the workflow writes (``\\input``/``{{file:path}}``). An
+unknown key or a missing file is an error, so the text cannot quote a number the
+run did not produce.
+
+Keys (``<m>`` a method run, ``<s>`` a subset): ``flights:<s>``, ``faultfree:<s>``,
+``precision:<m>:<s>``, ``recall:<m>:<s>``, ``accuracy:<m>:<s>`` (in %),
+``meandet:<m>:<s>``, ``maxdet:<m>:<s>`` (s), ``falsealarms:<m>:<s>`` ("k of n"),
+``best:<s>`` and ``bestaccuracy:<s>`` (the most accurate run), ``recallnofa:<m>:<s>``
+(the best recall of the threshold sweep with no false alarm on any flight, %),
+``paper:precision``, ``paper:recall``, ``paper:accuracy``, ``paper:meandet``,
+``paper:maxdet`` (Keipour et al. 2019, quoted).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import pandas as pd
+
+from .reference import ICRA2019_SUMMARY
+from .tables import latex_escape
+
+__all__ = ["latex_macros", "latex_keys", "paper_numbers", "render_markdown"]
+
+_PLACEHOLDER = re.compile(r"\{\{(num|file):([^}]+)\}\}")
+_LATEX_KEY = re.compile(r"\\result\{([^}]+)\}")
+_LATEX_COMMENT = re.compile(r"(?<!\\)%.*")
+_HTML_COMMENT = re.compile(r"<!--.*?-->", re.DOTALL)
+
+
+def _pct(v: float) -> str:
+    return "n/a" if math.isnan(v) else f"{100 * v:.2f}"
+
+
+def _sec(v: float) -> str:
+    return "n/a" if math.isnan(v) else f"{v:.2f}"
+
+
+def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame) -> dict[str, str]:
+    """Every quotable number, as text, by key (see the module docstring)."""
+    out = {f"paper:{k}": (_pct if k in ("precision", "recall", "accuracy") else _sec)(
+        ICRA2019_SUMMARY[key])
+        for k, key in (("precision", "precision"), ("recall", "recall"),
+                       ("accuracy", "accuracy"), ("meandet", "mean_detection_s"),
+                       ("maxdet", "max_detection_s"))}
+    for r in comparison.to_dict(orient="records"):
+        m, s = r["method"], r["subset"]
+        out[f"flights:{s}"] = str(r["flights"])
+        out[f"faultfree:{s}"] = str(r["fault_free_flights"])
+        for key in ("precision", "recall", "accuracy"):
+            out[f"{key}:{m}:{s}"] = _pct(r[key])
+        out[f"meandet:{m}:{s}"] = _sec(r["mean_detection_s"])
+        out[f"maxdet:{m}:{s}"] = _sec(r["max_detection_s"])
+        out[f"falsealarms:{m}:{s}"] = (f"{r['fault_free_false_alarms']} of "
+                                       f"{r['fault_free_flights']}")
+    for s, table in comparison.groupby("subset", sort=False):
+        best = table.sort_values(["accuracy", "method"], ascending=[False, True]).iloc[0]
+        out[f"best:{s}"] = best["method"]
+        out[f"bestaccuracy:{s}"] = _pct(best["accuracy"])
+    for (m, s), table in sweep.groupby(["method", "subset"], sort=False):
+        clean = table[table["fp"] == 0]
+        out[f"recallnofa:{m}:{s}"] = _pct(clean["recall"].max()) if len(clean) else "n/a"
+    return out
+
+
+def latex_macros(numbers: dict[str, str]) -> str:
+    """``\\result{key}`` for LaTeX; an undefined key stops the build."""
+    lines = [r"\newcommand{\result}[1]{\ifcsname abresult@#1\endcsname"
+             r"\csname abresult@#1\endcsname\else\errmessage{no result named #1}\fi}"]
+    lines += [rf"\expandafter\def\csname abresult@{k}\endcsname{{{latex_escape(v)}}}"
+              for k, v in sorted(numbers.items())]
+    return "\n".join(lines) + "\n"
+
+
+def latex_keys(tex: str) -> set[str]:
+    """The keys a LaTeX source quotes with ``\\result`` (outside comments)."""
+    return set(_LATEX_KEY.findall(_LATEX_COMMENT.sub("", tex)))
+
+
+def render_markdown(template: str, numbers: dict[str, str], root: Path) -> str:
+    """Drop HTML comments, fill ``{{num:key}}`` from ``numbers`` and ``{{file:path}}``
+    with the file at ``root / path``; raise ``KeyError`` or ``FileNotFoundError``
+    naming what is missing."""
+    def fill(match: re.Match) -> str:
+        kind, arg = match.group(1), match.group(2).strip()
+        if kind == "num":
+            if arg not in numbers:
+                raise KeyError(f"the manuscript quotes {arg!r}, which no result defines")
+            return numbers[arg]
+        path = root / arg
+        if not path.is_file():
+            raise FileNotFoundError(f"the manuscript includes {arg}, which was not written")
+        return path.read_text().strip()
+
+    return _PLACEHOLDER.sub(fill, _HTML_COMMENT.sub("", template)).lstrip()

@@ -1,0 +1,43 @@
+import shutil
+
+# The manuscript's inputs: every file it includes is written by the workflow.
+PAPER_INPUTS = [
+    *rules.tables.output,
+    "results/tables/sweep.csv",
+    "results/figures/sweep.png",
+    "results/figures/detection_time.png",
+]
+LATEX = shutil.which("latexmk")
+# the manuscript's sources live beside the Snakefile, whatever the working directory
+PAPER_DIR = Path(workflow.basedir) / "paper"
+
+
+rule paper_sources:
+    input:
+        PAPER_INPUTS,
+        comparison="results/tables/comparison.csv",
+        sweep="results/tables/sweep.csv",
+        tex=PAPER_DIR / "paper.tex",
+        markdown=PAPER_DIR / "paper.template.md",
+    output:
+        macros="paper/build/results.tex",
+        markdown=report("paper/build/paper.md", category="Manuscript"),
+    log:
+        "results/logs/paper_sources.log",
+    script:
+        "../scripts/paper.py"
+
+
+rule paper_pdf:
+    input:
+        PAPER_INPUTS,
+        "paper/build/results.tex",
+        tex=PAPER_DIR / "paper.tex",
+    output:
+        "paper/build/paper.pdf",
+    log:
+        "results/logs/paper_pdf.log",
+    shell:
+        # a fixed date in the PDF, so the same sources give the same bytes
+        "SOURCE_DATE_EPOCH=0 FORCE_SOURCE_DATE=1 latexmk -pdf -interaction=nonstopmode -halt-on-error -outdir=paper/build "
+        "{input.tex} > {log} 2>&1"

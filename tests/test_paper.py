@@ -1,0 +1,85 @@
+"""The manuscript quotes only what the run produced, in both of its forms."""
+
+import re
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from alfa_bench.analysis.paper import latex_keys, latex_macros, paper_numbers, render_markdown
+from alfa_bench.analysis.tables import comparison_latex
+
+REPO = Path(__file__).resolve().parent.parent
+TEX = (REPO / "paper/paper.tex").read_text()
+MARKDOWN = re.sub(r"<!--.*?-->", "", (REPO / "paper/paper.template.md").read_text(),
+                  flags=re.S)
+
+
+def comparison(**overrides):
+    row = {"subset": "all", "method": "a", "detector": "d", "calibration": "none",
+           "flights": 10, "precision": 0.5, "recall": 0.25, "accuracy": 0.4,
+           "mean_detection_s": 1.5, "max_detection_s": float("nan"),
+           "fault_free_flights": 3, "fault_free_false_alarms": 1, "armed_flights": 10}
+    rows = [row, {**row, "method": "b", "accuracy": 0.6}]
+    return pd.DataFrame([{**r, **overrides} for r in rows])
+
+
+def sweep():
+    return pd.DataFrame({"method": ["a", "a", "b"], "subset": ["all"] * 3,
+                         "fp": [0, 2, 1], "recall": [0.1, 0.9, 0.8]})
+
+
+def test_numbers_come_from_the_tables():
+    n = paper_numbers(comparison(), sweep())
+    assert n["accuracy:a:all"] == "40.00" and n["maxdet:a:all"] == "n/a"
+    assert n["best:all"] == "b" and n["bestaccuracy:all"] == "60.00"
+    assert n["falsealarms:a:all"] == "1 of 3"
+    assert n["recallnofa:a:all"] == "10.00" and n["recallnofa:b:all"] == "n/a"
+    assert n["paper:accuracy"] == "86.36"
+
+
+def test_markdown_refuses_unknown_keys_and_missing_files(tmp_path):
+    (tmp_path / "t.md").write_text("| x |\n")
+    text = render_markdown("<!-- {{num:ignored}} -->A {{num:k}} {{file:t.md}}", {"k": "1"},
+                           tmp_path)
+    assert text == "A 1 | x |"
+    with pytest.raises(KeyError, match="nope"):
+        render_markdown("{{num:nope}}", {}, tmp_path)
+    with pytest.raises(FileNotFoundError, match="gone.md"):
+        render_markdown("{{file:gone.md}}", {}, tmp_path)
+
+
+def test_latex_macros_define_every_key_and_stop_on_unknown_ones():
+    macros = latex_macros({"accuracy:rls_arx:all": "4.55", "best:all": "ffrls_monitor"})
+    assert r"\csname abresult@accuracy:rls_arx:all\endcsname{4.55}" in macros
+    assert r"{ffrls\_monitor}" in macros
+    assert r"\errmessage" in macros
+    assert latex_keys("% \\result{commented}\n\\result{a:b} 50\\% \\result{c}") == {"a:b", "c"}
+
+
+def test_the_twins_quote_the_same_results_and_include_the_same_outputs():
+    md_keys = set(re.findall(r"\{\{num:([^}]+)\}\}", MARKDOWN))
+    assert md_keys and md_keys == latex_keys(TEX)
+    md_files = {Path(f).stem for f in re.findall(r"\{\{file:([^}]+)\}\}", MARKDOWN)}
+    md_files |= {Path(f).stem for f in re.findall(r"\]\(([^)]+\.png)\)", MARKDOWN)}
+    tex_files = {Path(f).stem for f in re.findall(r"\\(?:input|includegraphics)(?:\[[^]]*\])?"
+                                                  r"\{(results/[^}]+)\}", TEX)}
+    assert md_files == tex_files
+
+
+def test_every_quoted_key_is_one_the_numbers_define():
+    """With the configured methods and subsets, every key the manuscript quotes exists."""
+    import yaml
+    config = yaml.safe_load((REPO / "config/config.yaml").read_text())
+    rows = [{**comparison().iloc[0].to_dict(), "method": m, "subset": s}
+            for m in config["methods"] for s in config["subsets"]]
+    sweeps = pd.DataFrame([{"method": m, "subset": s, "fp": 0, "recall": 0.0}
+                           for m in config["methods"] for s in config["subsets"]])
+    assert latex_keys(TEX) <= set(paper_numbers(pd.DataFrame(rows), sweeps))
+
+
+def test_latex_tables_escape_and_label():
+    tex = comparison_latex(comparison())
+    assert r"\label{tab:comparison-1}" in tex and r"\texttt{all}" in tex
+    assert "\\toprule" in tex and tex.count(r"\begin{table}") == 1
+    assert " & 50.00 & 25.00 & 40.00 & 1.50 & - & 1 of 3 & 10 \\\\" in tex
