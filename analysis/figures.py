@@ -51,7 +51,7 @@ def sweep_figure(sweep: pd.DataFrame, subset: str, path: str | Path) -> None:
     data = sweep[sweep["subset"] == subset]
     methods = list(dict.fromkeys(data["method"]))
     colors = _colors(methods)
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), layout="constrained")
+    fig, axes = plt.subplots(1, 3, figsize=(15, 5.0), layout="constrained")
     panels = [
         ("false_alarm_flights", "recall", "flights with a false alarm (share)",
          "detection rate (recall)", "linear"),
@@ -73,7 +73,8 @@ def sweep_figure(sweep: pd.DataFrame, subset: str, path: str | Path) -> None:
     axes[0].set_xlim(-0.02, 1.02)
     axes[0].set_ylim(-0.02, 1.02)
     axes[1].set_ylim(-0.02, 1.02)
-    axes[0].legend(fontsize=8, loc="lower right")
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside lower center", ncol=len(methods), fontsize=9)
     n = int(data["flights"].iloc[0]) if len(data) else 0
     fig.suptitle(f"Threshold sweep, subset '{subset}' ({n} flights): every channel "
                  "threshold scaled by one factor; dots = configured thresholds")
