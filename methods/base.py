@@ -88,6 +88,23 @@ class Detector(ABC):
         """Forget everything learned while running (not what :meth:`fit` learned);
         return self."""
 
+    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, np.ndarray, dict]:
+        """:meth:`reset`, then :meth:`update` over every step of ``s``: scores and
+        alarms, shape (n, c), and with ``probes`` the :meth:`probes` of every step.
+        Detectors may override it with a batch form; it must give the same alarms and
+        the same scores to rounding (the contract test checks)."""
+        self.reset()
+        n, c = s.t.size, len(self.channels())
+        score = np.empty((n, c))
+        alarm = np.empty((n, c), dtype=bool)
+        names = list(self.probes()) if probes else []
+        kept = np.full((n, len(names)), np.nan)
+        for k in range(n):
+            score[k], alarm[k] = self.update(s.x[k], s.fresh[k])
+            if names:
+                kept[k] = list(self.probes().values())
+        return score, alarm, {name: kept[:, i] for i, name in enumerate(names)}
+
     @abstractmethod
     def update(self, x: np.ndarray, fresh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Consume one time step.
@@ -153,19 +170,9 @@ def run_detector(detector: Detector, flight: Flight, probes: bool = False) -> Tr
     """Run ``detector`` causally over ``flight``, from a fresh state; with ``probes``,
     keep :meth:`Detector.probes` of every step."""
     s = sample(flight, detector.signals(), detector.rate_hz)
-    detector.reset()
-    n, c = s.t.size, len(detector.channels())
-    score = np.empty((n, c))
-    alarm = np.empty((n, c), dtype=bool)
-    names = list(detector.probes()) if probes else []
-    kept = np.full((n, len(names)), np.nan)
-    for k in range(n):
-        score[k], alarm[k] = detector.update(s.x[k], s.fresh[k])
-        if names:
-            kept[k] = list(detector.probes().values())
+    score, alarm, kept = detector.run(s, probes)
     return Trace(t=s.t, score=score, alarm=alarm, channels=detector.channels(),
-                 threshold=np.asarray(detector.thresholds(), dtype=float),
-                 probes={name: kept[:, i] for i, name in enumerate(names)})
+                 threshold=np.asarray(detector.thresholds(), dtype=float), probes=kept)
 
 
 def fault_free_segments(detector: Detector, flights: list[Flight],

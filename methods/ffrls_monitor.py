@@ -223,7 +223,7 @@ class FfRlsMonitor(Detector):
                     out[spec["name"]][0].append(eps)
                     out[spec["name"]][1].append(dtheta)
         if final:
-            return {spec["name"]: (m.rls.theta_, m.rls.cov_)
+            return {spec["name"]: (m.rls.theta_.copy(), m.rls.cov_.copy())
                     for spec, m in zip(self.models, self.models_, strict=True)}
         return {n: (np.array(e), np.array(d).reshape(-1, len(self.theta0_[n])))
                 for n, (e, d) in out.items()}
@@ -274,7 +274,7 @@ class FfRlsMonitor(Detector):
         else:
             eps = m.rls.update(phi, y)                     # (14)-(16)
         m.prediction, m.residual = y - eps, eps
-        m.thetas.append(m.rls.theta_)
+        m.thetas.append(m.rls.theta_.copy())          # theta_ changes in place
         if len(m.thetas) <= self._window():
             return eps, None
         return eps, m.thetas[-1] - m.thetas[0]             # theta(k) - theta(k - M)

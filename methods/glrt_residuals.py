@@ -33,15 +33,14 @@ inputs) so both residual generators see the same regressors.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from alfa_bench.data import Sampled
 
+from . import kernels
 from .arx import ArxRegressor, arx_regressors, fit_arx
 from .base import Detector
-from .glrt import WindowedGlrt, chi2_threshold, empirical_threshold, glrt_statistic
+from .glrt import chi2_threshold, empirical_threshold, glrt_statistic
 from .rls_arx_zscore import DEFAULT_PAIRS, RlsArxZscore, pair_signals
 
 __all__ = ["GlrtResiduals"]
@@ -76,8 +75,9 @@ class GlrtResiduals(Detector):
         Fault-free residual mean and variance per pair.
     threshold_ : ndarray
         :math:`\\gamma` per pair.
-    glrt_ : list of :class:`~.glrt.WindowedGlrt`
-        Per-pair test state (``g_``, ``change_``, ``mean_``).
+    glrt_buf_, glrt_count_ : ndarray
+        Per pair, the last :math:`M` centred residuals (newest first) and their count:
+        the state of :func:`~.kernels.glrt_advance`.
     residual_, output_ : ndarray
         The last residual (NaN while not armed) and output per pair.
     """
@@ -159,8 +159,7 @@ class GlrtResiduals(Detector):
                 r[start:, j] = y - phi @ self.theta_[j]        # r = y - phi' theta
             return r
         self._reset_residuals()
-        return np.array([self._residual_step(x, f) for x, f in zip(s.x, s.fresh, strict=True)]
-                        ).reshape(-1, len(self.pairs))
+        return self.rls_arx_.advance(s.x, s.fresh)["judged"]
 
     # -- streaming ---------------------------------------------------------------------
 
@@ -174,6 +173,20 @@ class GlrtResiduals(Detector):
     def update(self, x: np.ndarray, fresh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         g = self._glrt_step(self._residual_step(x, fresh))
         return g, g > self.threshold_
+
+    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, np.ndarray, dict]:
+        """The batch form: residuals of the whole segment at once, then the GLRT kernel;
+        equal to streaming to rounding."""
+        self.reset()
+        r = self._residual_run(s)
+        g = np.column_stack([self._glrt_run(j, r[:, j]) for j in range(len(self.pairs))])
+        kept = {}
+        if probes:
+            for j, (p, (_, iy)) in enumerate(zip(self.pairs, self.cols_, strict=True)):
+                kept[f"{p['name']}/prediction"] = s.x[:, iy] - r[:, j]
+                kept[f"{p['name']}/residual"] = r[:, j]
+        with np.errstate(invalid="ignore"):
+            return g, g > self.threshold_, kept
 
     def _validate(self) -> None:
         if self.residuals not in _RESIDUALS:
@@ -205,32 +218,31 @@ class GlrtResiduals(Detector):
         self.output_ = np.full(len(self.pairs), np.nan)
 
     def _residual_step(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:
+        self.output_ = np.array([x[iy] for _, iy in self.cols_], dtype=float)
+        if self.residuals == "rls":                    # e = y - phi' theta(k-1), once stable
+            self.residual_ = self.rls_arx_.advance(x[None, :], fresh[None, :])["judged"][0]
+            return self.residual_
         r = np.full(len(self.pairs), np.nan)
         for j, (iu, iy) in enumerate(self.cols_):
-            u, y = float(x[iu]), float(x[iy])
-            self.output_[j] = y
-            if self.residuals == "arx":
-                reg = self.arx_[j]
-                reg.push(u)
-                if reg.ready():
-                    r[j] = y - reg.phi() @ self.theta_[j]  # r = y - phi' theta
-                reg.push_output(y)
-            else:
-                pair = self.rls_arx_.pairs_[j]
-                judged = pair.model_stable
-                updates = pair.updates
-                self.rls_arx_._step(pair, u, y, bool(fresh[iy]))
-                if judged and pair.updates > updates:
-                    r[j] = pair.rls.error_             # e = y - phi' theta(k-1)
+            reg = self.arx_[j]
+            reg.push(float(x[iu]))
+            if reg.ready():
+                r[j] = x[iy] - reg.phi() @ self.theta_[j]  # r = y - phi' theta
+            reg.push_output(float(x[iy]))
         self.residual_ = r
         return r
 
     def _reset_glrt(self) -> None:
-        self.glrt_ = [WindowedGlrt(self._window(), float(v)).reset() for v in self.var_]
+        if not np.all(self.var_ > 0):
+            raise ValueError(f"GLRT residual variances must be > 0, got {self.var_}")
+        self.glrt_buf_ = np.zeros((len(self.pairs), self._window()))
+        self.glrt_count_ = np.zeros((len(self.pairs), 1), dtype=np.int64)
+
+    def _glrt_run(self, j: int, r: np.ndarray) -> np.ndarray:
+        g = np.empty(r.size)
+        kernels.glrt_advance(r - self.mean_[j], self.glrt_buf_[j], self.glrt_count_[j],
+                             float(self.var_[j]), g)   # x = r - mu0
+        return g
 
     def _glrt_step(self, r: np.ndarray) -> np.ndarray:
-        g = np.full(len(self.pairs), np.nan)
-        for j, rj in enumerate(r):
-            if math.isfinite(rj):
-                g[j] = self.glrt_[j].update(rj - self.mean_[j])  # x = r - mu0
-        return g
+        return np.array([self._glrt_run(j, r[j:j + 1])[0] for j in range(len(self.pairs))])

@@ -27,6 +27,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import kernels
+
 __all__ = ["RecursiveLeastSquares"]
 
 
@@ -48,9 +50,9 @@ class RecursiveLeastSquares:
     Attributes
     ----------
     theta_ : ndarray
-        :math:`\\hat\\theta(k)`.
+        :math:`\\hat\\theta(k)`, updated in place.
     cov_ : ndarray
-        :math:`C(k)`.
+        :math:`C(k)`, updated in place.
     error_, gain_, step_ : float, ndarray, ndarray
         :math:`\\hat e(k)`, :math:`L(k)` and :math:`L(k)\\hat e(k)` of the last update.
     """
@@ -75,21 +77,15 @@ class RecursiveLeastSquares:
         self.error_ = np.nan
         self.gain_ = np.zeros(self.n_params)
         self.step_ = np.zeros(self.n_params)
+        self._c_phi = np.zeros(self.n_params)
         return self
 
     def update(self, phi: np.ndarray, y: float) -> float:
-        """One RLS step; returns the a-priori error :math:`\\hat e(k)`."""
-        lam = self.forgetting
-        e = y - phi @ self.theta_                      # (4) e = y - phi' theta
-        c_phi = self.cov_ @ phi
-        gain = c_phi / (lam + phi @ c_phi)             # (5) L = C phi / (lam + phi' C phi)
-        step = gain * e
-        self.theta_ = self.theta_ + step               # (6) theta += L e
-        cov = (self.cov_ - np.outer(gain, c_phi)) / lam  # (7) C = (C - L phi' C) / lam
-        cov = 0.5 * (cov + cov.T)                      # keep C symmetric against round-off
-        trace = np.trace(cov)
-        if trace > self.max_trace:
-            cov *= self.max_trace / trace              # tr C <= max_trace: no wind-up
-        self.cov_ = cov
-        self.error_, self.gain_, self.step_ = float(e), gain, step
-        return self.error_
+        """One RLS step (in place on ``theta_`` and ``cov_``, by the compiled
+        :func:`~.kernels.rls_update`); returns the a-priori error :math:`\\hat e(k)`."""
+        e = kernels.rls_update(self.theta_, self.cov_, np.asarray(phi, dtype=float), float(y),
+                               float(self.forgetting), float(self.max_trace), self._c_phi,
+                               self.gain_)
+        self.error_ = e
+        self.step_ = self.gain_ * e
+        return e

@@ -6,7 +6,7 @@ For each input/output pair :math:`(u, y)` an ARX model (eq. 3)
 
     y(k) = \sum_{i=1}^{n_a} a_i\, y(k-i) + \sum_{j=0}^{n_b-1} b_j\, u(k-j) + n(k)
 
-is estimated online by RLS (eqs. 4-7, :class:`~.rls.RecursiveLeastSquares`) from
+is estimated online by RLS (eqs. 4-7 of :mod:`.rls`) from
 :math:`\hat\theta = 0` and a large diagonal covariance. The model is *stable* once
 :math:`\|L(k)\hat e(k)\|_\infty < \epsilon` has held for ``stable_s`` seconds, and
 not before ``warmup_samples`` steps. From then on the prediction error's mean and
@@ -21,6 +21,10 @@ each new error gets the z-score
 computed with the statistics *before* :math:`\hat e(k)` joins them (so an outlier
 does not shrink its own score), and the pair alarms when :math:`z(k) > 4.5`.
 Both stability flags latch. A flight alarms when any pair alarms.
+
+The recursion runs in the compiled kernel :func:`~.kernels.rls_arx_advance`, which
+streaming (:meth:`RlsArxZscore.update`, one step) and batch runs
+(:meth:`RlsArxZscore.run`, a flight) share.
 
 Parameters the paper states, kept as stated: the pairs (commanded roll and pitch
 against the measured angle and against the error measured - commanded); z = 4.5;
@@ -58,14 +62,12 @@ Choices the paper leaves open, and why these values (none was fitted to scores):
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from .arx import ArxRegressor
+from alfa_bench.data import Sampled
+
+from . import kernels
 from .base import Detector
-from .rls import RecursiveLeastSquares
-from .welford import Welford
 
 __all__ = ["DEFAULT_PAIRS", "RlsArxZscore", "pair_signals"]
 
@@ -85,23 +87,35 @@ def pair_signals(pairs) -> tuple[str, ...]:
 
 
 class _Pair:
-    """State of one input/output pair."""
+    """State of one input/output pair, in the arrays :func:`~.kernels.rls_arx_advance`
+    advances."""
 
     def __init__(self, det: RlsArxZscore, u_col: int, y_col: int):
         self.u_col, self.y_col = u_col, y_col
         nb = max(1, round(det.input_window_s * det.rate_hz))
-        self.regressor = ArxRegressor(det.na, nb).reset()
-        self.rls = RecursiveLeastSquares(det.na + nb, det.p0).reset()
-        self.welford = Welford()
-        self.k = 0                    # grid steps seen
-        self.updates = 0              # RLS updates made
-        self.streak_from = None       # step where ||L e|| < eps began
-        self.model_stable = False
-        self.var_from = None          # step where the variance began to hold still
-        self.var_stable = False
-        self.last_var = math.nan
-        self.prediction = math.nan    # y - e of the last RLS update at this step
-        self.residual = math.nan
+        n = det.na + nb
+        self.theta = np.zeros(n)                       # theta(0) = 0
+        self.cov = np.eye(n) * det.p0                  # C(0) = p0 I
+        self.ubuf = np.zeros(nb)
+        self.ybuf = np.zeros(max(det.na, 1))
+        self.phi, self.c_phi, self.gain = np.zeros(n), np.zeros(n), np.zeros(n)
+        self.ints = np.zeros(kernels.ARX_INTS, dtype=np.int64)
+        self.ints[[kernels.STREAK_FROM, kernels.VAR_FROM]] = -1
+        self.floats = np.zeros(kernels.ARX_FLOATS)
+        self.floats[kernels.LAST_VAR] = np.nan
+
+    @property
+    def updates(self) -> int:
+        """RLS updates made."""
+        return int(self.ints[kernels.UPDATES])
+
+    @property
+    def model_stable(self) -> bool:
+        return bool(self.ints[kernels.MODEL_STABLE])
+
+    @property
+    def var_stable(self) -> bool:
+        return bool(self.ints[kernels.VAR_STABLE])
 
 
 class RlsArxZscore(Detector):
@@ -131,8 +145,10 @@ class RlsArxZscore(Detector):
     Attributes
     ----------
     pairs_ : list
-        Per-pair state: ``rls`` (with ``theta_``, ``error_``, ``gain_``),
-        ``welford``, flags ``model_stable`` and ``var_stable``.
+        Per-pair state: ``theta``, ``cov``, the regressor buffers, Welford's
+        statistics, flags ``model_stable`` and ``var_stable``.
+    last_ : dict of ndarray
+        Per pair, the outputs of the last step (see :meth:`advance`).
     """
 
     def __init__(self, pairs=DEFAULT_PAIRS, rate_hz=25.0, na=1, input_window_s=1.0,
@@ -161,11 +177,7 @@ class RlsArxZscore(Detector):
         return np.full(len(self.pairs), float(self.z_threshold))
 
     def probes(self) -> dict[str, float]:
-        out = {}
-        for spec, p in zip(self.pairs, self.pairs_, strict=True):
-            out[f"{spec['name']}/prediction"] = p.prediction
-            out[f"{spec['name']}/residual"] = p.residual
-        return out
+        return _probes(self.pairs, {k: v[-1] for k, v in self.last_.items()})
 
     def reset(self) -> RlsArxZscore:
         if self.repeated_samples not in _REPEATED:
@@ -177,56 +189,46 @@ class RlsArxZscore(Detector):
         self.pairs_ = [_Pair(self, cols[p["input"]], cols[p["output"]]) for p in self.pairs]
         self.stable_steps_ = round(self.stable_s * self.rate_hz)
         self.var_steps_ = round(self.var_stable_s * self.rate_hz)
+        self.last_ = {k: np.full((1, len(self.pairs)), np.nan) for k in _OUTPUTS}
         return self
 
+    def advance(self, x: np.ndarray, fresh: np.ndarray) -> dict[str, np.ndarray]:
+        """Consume the steps of ``x`` and ``fresh`` (shape (n, m)); return per step and
+        pair (shape (n, pairs)) ``z``, ``prediction`` and ``residual`` of an RLS update,
+        and ``judged``, the residual of a pair whose model was already stable."""
+        x = np.asarray(x, dtype=float)
+        n = x.shape[0]
+        out = {k: np.empty((len(self.pairs_), n)) for k in _OUTPUTS}
+        for j, p in enumerate(self.pairs_):
+            kernels.rls_arx_advance(
+                np.ascontiguousarray(x[:, p.u_col]), np.ascontiguousarray(x[:, p.y_col]),
+                np.ascontiguousarray(fresh[:, p.y_col]), p.ints, p.floats, p.theta, p.cov,
+                p.ubuf, p.ybuf, p.phi, p.c_phi, p.gain, self.na, self.warmup_samples,
+                self.eps, self.stable_steps_, self.var_rtol, self.var_steps_,
+                self.repeated_samples == "fresh", out["z"][j], out["prediction"][j],
+                out["residual"][j], out["judged"][j])
+        out = {k: v.T for k, v in out.items()}
+        self.last_ = {k: v[-1:] for k, v in out.items()}
+        return out
+
     def update(self, x: np.ndarray, fresh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        n = len(self.pairs_)
-        score = np.full(n, np.nan)
-        alarm = np.zeros(n, dtype=bool)
-        for j, pair in enumerate(self.pairs_):
-            z = self._step(pair, float(x[pair.u_col]), float(x[pair.y_col]),
-                           bool(fresh[pair.y_col]))
-            score[j] = z
-            alarm[j] = z > self.z_threshold
-        return score, alarm
+        z = self.advance(x[None, :], fresh[None, :])["z"][0]
+        return z, z > self.z_threshold
 
-    def _step(self, p: _Pair, u: float, y: float, fresh: bool) -> float:
-        k = p.k
-        p.k += 1
-        p.prediction = p.residual = math.nan
-        reg = p.regressor
-        reg.push(u)
-        if self.repeated_samples == "fresh" and not fresh:
-            return math.nan
-        if not reg.ready():
-            reg.push_output(y)
-            return math.nan
-        e = p.rls.update(reg.phi(), y)
-        p.prediction, p.residual = y - e, e
-        reg.push_output(y)
-        p.updates += 1
+    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, np.ndarray, dict]:
+        out = self.reset().advance(s.x, s.fresh)
+        kept = ({name: out[kind][:, j] for name, (kind, j) in _probe_index(self.pairs).items()}
+                if probes else {})
+        return out["z"], out["z"] > self.z_threshold, kept
 
-        if not p.model_stable:
-            if np.max(np.abs(p.rls.step_)) < self.eps:
-                p.streak_from = k if p.streak_from is None else p.streak_from
-            else:
-                p.streak_from = None
-            p.model_stable = (p.streak_from is not None and p.updates >= self.warmup_samples
-                              and k - p.streak_from >= self.stable_steps_)
-            return math.nan
 
-        w = p.welford
-        z = math.nan
-        if p.var_stable:
-            dev = abs(e - w.mean_)
-            z = dev / math.sqrt(w.variance) if w.variance > 0 else (math.inf if dev else 0.0)
-        w.update(e)
-        var = w.variance
-        if not p.var_stable and w.n_ > 2:
-            if abs(var - p.last_var) <= self.var_rtol * p.last_var:
-                p.var_from = k if p.var_from is None else p.var_from
-            else:
-                p.var_from = None
-            p.var_stable = p.var_from is not None and k - p.var_from >= self.var_steps_
-        p.last_var = var
-        return z
+_OUTPUTS = ("z", "prediction", "residual", "judged")
+
+
+def _probe_index(pairs) -> dict[str, tuple[str, int]]:
+    return {f"{p['name']}/{kind}": (kind, j) for j, p in enumerate(pairs)
+            for kind in ("prediction", "residual")}
+
+
+def _probes(pairs, last: dict[str, np.ndarray]) -> dict[str, float]:
+    return {name: float(last[kind][j]) for name, (kind, j) in _probe_index(pairs).items()}

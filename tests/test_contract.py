@@ -13,9 +13,10 @@ import numpy as np
 import pytest
 import yaml
 
-from alfa_bench.data import load_flight
+from alfa_bench.data import load_flight, sample
 from alfa_bench.methods import (
     REGISTRY,
+    Detector,
     NotFittedError,
     fault_free_segments,
     make_detector,
@@ -105,6 +106,22 @@ def test_probes_are_named_once_and_do_not_change_the_run(detector, one_flight):
     for name, values in probed.probes.items():
         assert values.shape == probed.t.shape
         assert np.isfinite(values).any(), f"probe {name} is never computed"
+
+
+def test_batch_run_equals_streaming(detector, one_flight):
+    """A detector's own run() (batch or compiled) gives the scores and probes of update()
+    step by step to rounding, and the same alarms wherever a score is not within
+    rounding of its threshold."""
+    s = sample(load_flight(one_flight), detector.signals(), detector.rate_hz)
+    score, alarm, probes = detector.run(s, probes=True)
+    ref_score, ref_alarm, ref_probes = Detector.run(detector, s, probes=True)
+    np.testing.assert_allclose(score, ref_score, rtol=1e-9, atol=1e-9)
+    thr = detector.thresholds()
+    tie = np.abs(ref_score - thr) <= 1e-9 * np.maximum(1.0, thr)
+    np.testing.assert_array_equal(alarm[~tie], ref_alarm[~tie])
+    assert list(probes) == list(ref_probes)
+    for name in probes:
+        np.testing.assert_allclose(probes[name], ref_probes[name], rtol=1e-9, atol=1e-9)
 
 
 def test_deterministic(detector, one_flight):

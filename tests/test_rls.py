@@ -2,9 +2,9 @@
 
 import numpy as np
 import pytest
+from reference_rls_arx import Welford
 
 from alfa_bench.methods.rls import RecursiveLeastSquares
-from alfa_bench.methods.welford import Welford
 
 
 def regression(n=400, p=5, seed=0):

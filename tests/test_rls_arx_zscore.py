@@ -34,8 +34,8 @@ def test_identifies_the_system_and_arms():
     p = det.pairs_[0]
     assert p.model_stable and p.var_stable
     # theta = [a1, b0, b1, ...]: the true system is a1 = 0.8, b0 = 0.2, the rest 0
-    np.testing.assert_allclose(p.rls.theta_[:2], [0.8, 0.2], atol=0.02)
-    np.testing.assert_allclose(p.rls.theta_[2:], 0, atol=0.02)
+    np.testing.assert_allclose(p.theta[:2], [0.8, 0.2], atol=0.02)
+    np.testing.assert_allclose(p.theta[2:], 0, atol=0.02)
     armed = np.flatnonzero(np.isfinite(score))[0]
     assert armed >= det.warmup_samples
     assert not alarm.any(), "fault-free Gaussian data must not alarm at z > 4.5"

@@ -1,0 +1,264 @@
+"""The plain per-sample NumPy RLS and RLS-ARX z-score detector: the references for the
+compiled ones.
+
+This is the implementation the project ran before its detector core was compiled
+(``methods/kernels.py``): per-sample Python with a NumPy RLS step, a deque regressor
+and Welford's method. The tests hold the compiled detector to it,
+and ``benchmarks/`` times both.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from alfa_bench.methods.arx import ArxRegressor
+from alfa_bench.methods.base import Detector
+from alfa_bench.methods.rls_arx_zscore import DEFAULT_PAIRS, pair_signals
+
+
+class PlainRecursiveLeastSquares:
+    """The plain NumPy RLS step of :class:`alfa_bench.methods.rls.RecursiveLeastSquares`.
+
+    Parameters
+    ----------
+    n_params : int
+        Length of the regressor :math:`\\phi`.
+    p0 : float
+        Initial covariance :math:`C(0) = p_0 I`; large means little trust in
+        :math:`\\hat\\theta(0) = 0`.
+    forgetting : float
+        :math:`\\lambda \\in (0, 1]`.
+    max_trace : float
+        Bound on :math:`\\operatorname{tr} C(k)`; ``inf`` for none.
+
+    Attributes
+    ----------
+    theta_ : ndarray
+        :math:`\\hat\\theta(k)`.
+    cov_ : ndarray
+        :math:`C(k)`.
+    error_, gain_, step_ : float, ndarray, ndarray
+        :math:`\\hat e(k)`, :math:`L(k)` and :math:`L(k)\\hat e(k)` of the last update.
+    """
+
+    def __init__(self, n_params: int, p0: float = 1e6, forgetting: float = 1.0,
+                 max_trace: float = np.inf):
+        self.n_params = n_params
+        self.p0 = p0
+        self.forgetting = forgetting
+        self.max_trace = max_trace
+
+    def reset(self, theta: np.ndarray | None = None,
+              cov: np.ndarray | None = None) -> PlainRecursiveLeastSquares:
+        """Start from :math:`\\hat\\theta(0)` = ``theta`` (zeros) and
+        :math:`C(0)` = ``cov`` (:math:`p_0 I`)."""
+        if not 0.0 < self.forgetting <= 1.0:
+            raise ValueError(f"forgetting must be in (0, 1], got {self.forgetting}")
+        if not self.max_trace > 0:
+            raise ValueError(f"max_trace must be > 0, got {self.max_trace}")
+        self.theta_ = np.zeros(self.n_params) if theta is None else np.array(theta, float)
+        self.cov_ = np.eye(self.n_params) * self.p0 if cov is None else np.array(cov, float)
+        self.error_ = np.nan
+        self.gain_ = np.zeros(self.n_params)
+        self.step_ = np.zeros(self.n_params)
+        return self
+
+    def update(self, phi: np.ndarray, y: float) -> float:
+        """One RLS step; returns the a-priori error :math:`\\hat e(k)`."""
+        lam = self.forgetting
+        e = y - phi @ self.theta_                      # (4) e = y - phi' theta
+        c_phi = self.cov_ @ phi
+        gain = c_phi / (lam + phi @ c_phi)             # (5) L = C phi / (lam + phi' C phi)
+        step = gain * e
+        self.theta_ = self.theta_ + step               # (6) theta += L e
+        cov = (self.cov_ - np.outer(gain, c_phi)) / lam  # (7) C = (C - L phi' C) / lam
+        cov = 0.5 * (cov + cov.T)                      # keep C symmetric against round-off
+        trace = np.trace(cov)
+        if trace > self.max_trace:
+            cov *= self.max_trace / trace              # tr C <= max_trace: no wind-up
+        self.cov_ = cov
+        self.error_, self.gain_, self.step_ = float(e), gain, step
+        return self.error_
+
+
+class Welford:
+    """Numerically stable running mean and sample variance.
+
+    Attributes
+    ----------
+    n_ : int
+    mean_ : float
+    m2_ : float
+    """
+
+    def __init__(self):
+        self.reset()
+
+    def reset(self) -> Welford:
+        self.n_, self.mean_, self.m2_ = 0, 0.0, 0.0
+        return self
+
+    def update(self, x: float) -> None:
+        self.n_ += 1
+        delta = x - self.mean_
+        self.mean_ += delta / self.n_         # mean_n = mean_{n-1} + (x - mean_{n-1}) / n
+        self.m2_ += delta * (x - self.mean_)  # M2_n += (x - mean_{n-1})(x - mean_n)
+
+    @property
+    def variance(self) -> float:
+        """Sample variance :math:`s_n^2`; NaN for fewer than two samples."""
+        return self.m2_ / (self.n_ - 1) if self.n_ > 1 else math.nan
+
+
+_REPEATED = ("hold", "fresh")
+
+
+class _Pair:
+    """State of one input/output pair."""
+
+    def __init__(self, det: PlainRlsArxZscore, u_col: int, y_col: int):
+        self.u_col, self.y_col = u_col, y_col
+        nb = max(1, round(det.input_window_s * det.rate_hz))
+        self.regressor = ArxRegressor(det.na, nb).reset()
+        self.rls = PlainRecursiveLeastSquares(det.na + nb, det.p0).reset()
+        self.welford = Welford()
+        self.k = 0                    # grid steps seen
+        self.updates = 0              # RLS updates made
+        self.streak_from = None       # step where ||L e|| < eps began
+        self.model_stable = False
+        self.var_from = None          # step where the variance began to hold still
+        self.var_stable = False
+        self.last_var = math.nan
+        self.prediction = math.nan    # y - e of the last RLS update at this step
+        self.residual = math.nan
+
+
+class PlainRlsArxZscore(Detector):
+    """The plain RLS-ARX z-score detector; parameters as in
+    :mod:`alfa_bench.methods.rls_arx_zscore`.
+
+    Parameters
+    ----------
+    pairs : sequence of dict
+        ``{"name", "input", "output"}``, signal names from
+        :data:`alfa_bench.data.SIGNALS`.
+    rate_hz : float
+    na : int
+        ARX output order :math:`n_a`.
+    input_window_s : float
+        Seconds of inputs in the regressor; :math:`n_b` = round(window x rate).
+    p0 : float
+        Initial RLS covariance :math:`C(0) = p_0 I`.
+    warmup_samples : int
+        Steps before a model may be declared stable.
+    eps, stable_s : float
+        Model stability: :math:`\\|L\\hat e\\|_\\infty < \\epsilon` for ``stable_s``.
+    var_rtol, var_stable_s : float
+        Variance stability.
+    z_threshold : float
+    repeated_samples : {"hold", "fresh"}
+
+    Attributes
+    ----------
+    pairs_ : list
+        Per-pair state: ``rls`` (with ``theta_``, ``error_``, ``gain_``),
+        ``welford``, flags ``model_stable`` and ``var_stable``.
+    """
+
+    def __init__(self, pairs=DEFAULT_PAIRS, rate_hz=25.0, na=1, input_window_s=1.0,
+                 p0=1e6, warmup_samples=200, eps=1e-3, stable_s=1.0, var_rtol=0.01,
+                 var_stable_s=1.0, z_threshold=4.5, repeated_samples="hold"):
+        self.pairs = pairs
+        self.rate_hz = rate_hz
+        self.na = na
+        self.input_window_s = input_window_s
+        self.p0 = p0
+        self.warmup_samples = warmup_samples
+        self.eps = eps
+        self.stable_s = stable_s
+        self.var_rtol = var_rtol
+        self.var_stable_s = var_stable_s
+        self.z_threshold = z_threshold
+        self.repeated_samples = repeated_samples
+
+    def signals(self) -> tuple[str, ...]:
+        return pair_signals(self.pairs)
+
+    def channels(self) -> tuple[str, ...]:
+        return tuple(p["name"] for p in self.pairs)
+
+    def thresholds(self) -> np.ndarray:
+        return np.full(len(self.pairs), float(self.z_threshold))
+
+    def probes(self) -> dict[str, float]:
+        out = {}
+        for spec, p in zip(self.pairs, self.pairs_, strict=True):
+            out[f"{spec['name']}/prediction"] = p.prediction
+            out[f"{spec['name']}/residual"] = p.residual
+        return out
+
+    def reset(self) -> PlainRlsArxZscore:
+        if self.repeated_samples not in _REPEATED:
+            raise ValueError(f"repeated_samples must be one of {_REPEATED}, "
+                             f"got {self.repeated_samples!r}")
+        if self.na < 0:
+            raise ValueError(f"na must be >= 0, got {self.na}")
+        cols = {s: i for i, s in enumerate(self.signals())}
+        self.pairs_ = [_Pair(self, cols[p["input"]], cols[p["output"]]) for p in self.pairs]
+        self.stable_steps_ = round(self.stable_s * self.rate_hz)
+        self.var_steps_ = round(self.var_stable_s * self.rate_hz)
+        return self
+
+    def update(self, x: np.ndarray, fresh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        n = len(self.pairs_)
+        score = np.full(n, np.nan)
+        alarm = np.zeros(n, dtype=bool)
+        for j, pair in enumerate(self.pairs_):
+            z = self._step(pair, float(x[pair.u_col]), float(x[pair.y_col]),
+                           bool(fresh[pair.y_col]))
+            score[j] = z
+            alarm[j] = z > self.z_threshold
+        return score, alarm
+
+    def _step(self, p: _Pair, u: float, y: float, fresh: bool) -> float:
+        k = p.k
+        p.k += 1
+        p.prediction = p.residual = math.nan
+        reg = p.regressor
+        reg.push(u)
+        if self.repeated_samples == "fresh" and not fresh:
+            return math.nan
+        if not reg.ready():
+            reg.push_output(y)
+            return math.nan
+        e = p.rls.update(reg.phi(), y)
+        p.prediction, p.residual = y - e, e
+        reg.push_output(y)
+        p.updates += 1
+
+        if not p.model_stable:
+            if np.max(np.abs(p.rls.step_)) < self.eps:
+                p.streak_from = k if p.streak_from is None else p.streak_from
+            else:
+                p.streak_from = None
+            p.model_stable = (p.streak_from is not None and p.updates >= self.warmup_samples
+                              and k - p.streak_from >= self.stable_steps_)
+            return math.nan
+
+        w = p.welford
+        z = math.nan
+        if p.var_stable:
+            dev = abs(e - w.mean_)
+            z = dev / math.sqrt(w.variance) if w.variance > 0 else (math.inf if dev else 0.0)
+        w.update(e)
+        var = w.variance
+        if not p.var_stable and w.n_ > 2:
+            if abs(var - p.last_var) <= self.var_rtol * p.last_var:
+                p.var_from = k if p.var_from is None else p.var_from
+            else:
+                p.var_from = None
+            p.var_stable = p.var_from is not None and k - p.var_from >= self.var_steps_
+        p.last_var = var
+        return z
