@@ -23,6 +23,7 @@ include: "rules/paper.smk"
 rule all:
     input:
         rules.tables.output,
+        rules.runtime.output,
         rules.sweep.output,
         rules.figures.output,
         rules.readme_figure.output,

@@ -18,3 +18,16 @@ rule tables:
         "results/logs/tables.log",
     script:
         "../scripts/tables.py"
+
+
+rule runtime:
+    input:
+        detections=expand("results/detections/{method}", method=METHODS),
+        benchmarks=expand("results/benchmarks/detect/{method}.tsv", method=METHODS),
+    output:
+        csv="results/runtime/runtime.csv",
+        md=report("results/runtime/runtime.md", category="Runtime"),
+    log:
+        "results/logs/runtime.log",
+    script:
+        "../scripts/runtime.py"

@@ -1,0 +1,36 @@
+"""Runtime of the detector jobs, from Snakemake's ``benchmark:`` files.
+
+One row per method run: wall and CPU seconds of its detect job (loading the flights,
+fitting every fold, running every flight, writing records and traces), the flights
+it scored, seconds per flight and peak memory. Times vary between runs, so this table
+is kept apart from the results, which do not.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+
+__all__ = ["runtime_markdown", "runtime_table"]
+
+
+def runtime_table(benchmarks: list[str | Path], flights: dict[str, int]) -> pd.DataFrame:
+    """``benchmarks``: ``results/benchmarks/detect/<method>.tsv``; ``flights``: the
+    number of flights each method scored."""
+    rows = []
+    for path in benchmarks:
+        method = Path(path).stem
+        b = pd.read_csv(path, sep="\t").iloc[-1]
+        rows.append({"method": method, "flights": flights[method], "wall_s": b["s"],
+                     "cpu_s": b["cpu_time"], "s_per_flight": b["s"] / flights[method],
+                     "max_rss_mb": b["max_rss"]})
+    return pd.DataFrame(rows)
+
+
+def runtime_markdown(table: pd.DataFrame) -> str:
+    lines = ["| method | flights | wall s | CPU s | s / flight | peak MB |",
+             "|---|---|---|---|---|---|"]
+    lines += [f"| {r.method} | {r.flights} | {r.wall_s:.2f} | {r.cpu_s:.2f} | "
+              f"{r.s_per_flight:.3f} | {r.max_rss_mb:.0f} |" for r in table.itertuples()]
+    return "\n".join(lines) + "\n"
