@@ -1,3 +1,6 @@
+import json
+
+
 rule detect:
     input:
         manifest="data/flights.csv",
@@ -5,7 +8,8 @@ rule detect:
         detections=directory("results/detections/{method}"),
         traces=directory("results/traces/{method}"),
     params:
-        spec=lambda w: config["methods"][w.method],
+        # canonical JSON, so that only a changed value (not a reordered key) re-runs it
+        spec=lambda w: json.dumps(config["methods"][w.method], sort_keys=True),
         processed=str(PROCESSED),
         calibration=config["calibration"],
     log:

@@ -5,7 +5,8 @@ rule rerun_logs:
     output:
         directory("results/rerun"),
     params:
-        methods=config["methods"],
+        # canonical JSON: reordered keys are not a change (the tab order follows input)
+        methods=json.dumps(config["methods"], sort_keys=True),
         processed=str(PROCESSED),
     log:
         "results/logs/rerun_logs.log",

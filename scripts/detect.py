@@ -1,6 +1,7 @@
 """Snakemake script: run one configured method over every flight with ground truth;
 write its detection records and traces."""
 
+import json
 import logging
 from pathlib import Path
 
@@ -17,7 +18,7 @@ out.mkdir(parents=True, exist_ok=True)
 traces.mkdir(parents=True, exist_ok=True)
 flights = {name: load_flight(Path(sm.params.processed) / name)
            for name in manifest.loc[manifest["ground_truth"], "flight"]}
-for record, trace in detect_all(sm.wildcards.method, dict(sm.params.spec), flights, manifest,
+for record, trace in detect_all(sm.wildcards.method, json.loads(sm.params.spec), flights, manifest,
                                 dict(sm.params.calibration)):
     write_record(record, out / f"{record['flight']}.json")
     write_trace(trace, traces / f"{record['flight']}.npz")

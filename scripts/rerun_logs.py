@@ -1,5 +1,6 @@
 """Snakemake script: one rerun recording per flight with every method's traces."""
 
+import json
 import logging
 from pathlib import Path
 
@@ -12,12 +13,13 @@ from alfa_bench.methods import make_detector
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 manifest = read_manifest(sm.input.manifest)
-specs = dict(sm.params.methods)
+specs = json.loads(sm.params.methods)
+order = [Path(d).name for d in sm.input.traces]
 detectors = [make_detector(spec["detector"], spec.get("params")) for spec in specs.values()]
 signals = list(dict.fromkeys(s for d in detectors for s in d.signals()))
 traces = read_traces(sm.input.traces)
 out = Path(sm.output[0])
 for flight in manifest.loc[manifest["ground_truth"], "flight"]:
     write_rerun_log(load_flight(Path(sm.params.processed) / flight),
-                    {m: traces[m, flight] for m in specs}, signals, out / f"{flight}.rrd")
+                    {m: traces[m, flight] for m in order}, signals, out / f"{flight}.rrd")
     logging.info("%s: written", flight)
