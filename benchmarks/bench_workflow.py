@@ -1,0 +1,91 @@
+"""Wall time of ``snakemake all --cores 2`` from a clean ``results/``, and how it grows.
+
+    ALFA_DIR=/path/to/alfa .venv/bin/python benchmarks/bench_workflow.py \
+        [--flights 1 2 4] [--settings 1 4 16]
+
+- ``--flights``: the flights of ``$ALFA_DIR/processed`` replicated k times (copies are
+  symlinks under new names on the same dates, so the leave-one-day-out folds stay
+  the same and each fold calibrates on k times the data), every configured method.
+- ``--settings``: the configured methods plus k settings of ``glrt_arx`` (its
+  false-alarm probability swept), over the flights once.
+
+Each case runs in a fresh temporary working directory; prints a Markdown table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import yaml
+
+ROOT = Path(__file__).resolve().parent.parent
+_TIME = re.compile(r"^(carbonZ_\d{4}-\d{2}-\d{2}-)(\d{2})(-\d{2}-\d{2}.*)$")
+
+
+def replicate(processed: Path, dest: Path, copies: int) -> int:
+    """Symlink every flight of ``processed`` ``copies`` times into ``dest``; copy r moves
+    the recording hour by 10 r (names stay distinct and parseable)."""
+    n = 0
+    for flight in sorted(p for p in processed.iterdir() if p.is_dir()):
+        for r in range(copies):
+            m = _TIME.match(flight.name)
+            name = f"{m[1]}{int(m[2]) + 10 * r:02d}{m[3]}"
+            folder = dest / name
+            folder.mkdir(parents=True)
+            for f in flight.iterdir():
+                (folder / f.name.replace(flight.name, name, 1)).symlink_to(f.resolve())
+            n += 1
+    return n
+
+
+def run(alfa: Path, config: Path, work: Path) -> float:
+    cmd = [sys.executable, "-m", "snakemake", "all", "--cores", "2", "--quiet",
+           "--snakefile", str(ROOT / "Snakefile"), "--directory", str(work),
+           "--configfile", str(config)]
+    t = time.perf_counter()
+    subprocess.run(cmd, env={**os.environ, "ALFA_DIR": str(alfa)}, check=True,
+                   capture_output=True)
+    return time.perf_counter() - t
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--flights", type=int, nargs="*", default=[1, 2, 4])
+    ap.add_argument("--settings", type=int, nargs="*", default=[1, 4, 16])
+    args = ap.parse_args()
+    processed = Path(os.environ["ALFA_DIR"]) / "processed"
+    base = yaml.safe_load((ROOT / "config/config.yaml").read_text())
+    print("| case | flights found | method runs | wall s |")
+    print("|---|---|---|---|")
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        config = tmp / "config.yaml"
+        config.write_text(yaml.safe_dump(base))
+        for k in args.flights:
+            alfa = tmp / f"alfa{k}"
+            n = replicate(processed, alfa / "processed", k)
+            wall = run(alfa, config, tmp / f"flights{k}")
+            print(f"| flights x{k} | {n} | {len(base['methods'])} | {wall:.1f} |", flush=True)
+        for k in args.settings:
+            swept = dict(base)
+            swept["methods"] = {**base["methods"], **{
+                f"glrt_arx_pf{i}": {"detector": "glrt_residuals", "params": {
+                    **base["methods"]["glrt_arx"]["params"],
+                    "false_alarm": 1e-4 * (i + 1)}} for i in range(k)}}
+            config = tmp / f"config{k}.yaml"
+            config.write_text(yaml.safe_dump(swept))
+            n = sum(1 for p in processed.iterdir() if p.is_dir())
+            wall = run(processed.parent, config, tmp / f"settings{k}")
+            print(f"| glrt_arx settings x{k} | {n} | {len(swept['methods'])} | {wall:.1f} |",
+                  flush=True)
+
+
+if __name__ == "__main__":
+    main()
