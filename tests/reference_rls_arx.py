@@ -15,55 +15,13 @@ import numpy as np
 
 from alfa_bench.methods.arx import ArxRegressor
 from alfa_bench.methods.base import Detector
-from alfa_bench.methods.rls_arx_zscore import DEFAULT_PAIRS, pair_signals
+from alfa_bench.methods.rls import RecursiveLeastSquares
+from alfa_bench.methods.rls_arx_zscore import RlsArxZscore
 
 
-class PlainRecursiveLeastSquares:
-    """The plain NumPy RLS step of :class:`alfa_bench.methods.rls.RecursiveLeastSquares`.
-
-    Parameters
-    ----------
-    n_params : int
-        Length of the regressor :math:`\\phi`.
-    p0 : float
-        Initial covariance :math:`C(0) = p_0 I`; large means little trust in
-        :math:`\\hat\\theta(0) = 0`.
-    forgetting : float
-        :math:`\\lambda \\in (0, 1]`.
-    max_trace : float
-        Bound on :math:`\\operatorname{tr} C(k)`; ``inf`` for none.
-
-    Attributes
-    ----------
-    theta_ : ndarray
-        :math:`\\hat\\theta(k)`.
-    cov_ : ndarray
-        :math:`C(k)`.
-    error_, gain_, step_ : float, ndarray, ndarray
-        :math:`\\hat e(k)`, :math:`L(k)` and :math:`L(k)\\hat e(k)` of the last update.
-    """
-
-    def __init__(self, n_params: int, p0: float = 1e6, forgetting: float = 1.0,
-                 max_trace: float = np.inf):
-        self.n_params = n_params
-        self.p0 = p0
-        self.forgetting = forgetting
-        self.max_trace = max_trace
-
-    def reset(self, theta: np.ndarray | None = None,
-              cov: np.ndarray | None = None) -> PlainRecursiveLeastSquares:
-        """Start from :math:`\\hat\\theta(0)` = ``theta`` (zeros) and
-        :math:`C(0)` = ``cov`` (:math:`p_0 I`)."""
-        if not 0.0 < self.forgetting <= 1.0:
-            raise ValueError(f"forgetting must be in (0, 1], got {self.forgetting}")
-        if not self.max_trace > 0:
-            raise ValueError(f"max_trace must be > 0, got {self.max_trace}")
-        self.theta_ = np.zeros(self.n_params) if theta is None else np.array(theta, float)
-        self.cov_ = np.eye(self.n_params) * self.p0 if cov is None else np.array(cov, float)
-        self.error_ = np.nan
-        self.gain_ = np.zeros(self.n_params)
-        self.step_ = np.zeros(self.n_params)
-        return self
+class PlainRecursiveLeastSquares(RecursiveLeastSquares):
+    """:class:`~alfa_bench.methods.rls.RecursiveLeastSquares` with its step in plain
+    NumPy (new arrays each step, no compiled kernel)."""
 
     def update(self, phi: np.ndarray, y: float) -> float:
         """One RLS step; returns the a-priori error :math:`\\hat e(k)`."""
@@ -135,30 +93,9 @@ class _Pair:
         self.residual = math.nan
 
 
-class PlainRlsArxZscore(Detector):
-    """The plain RLS-ARX z-score detector; parameters as in
-    :mod:`alfa_bench.methods.rls_arx_zscore`.
-
-    Parameters
-    ----------
-    pairs : sequence of dict
-        ``{"name", "input", "output"}``, signal names from
-        :data:`alfa_bench.data.SIGNALS`.
-    rate_hz : float
-    na : int
-        ARX output order :math:`n_a`.
-    input_window_s : float
-        Seconds of inputs in the regressor; :math:`n_b` = round(window x rate).
-    p0 : float
-        Initial RLS covariance :math:`C(0) = p_0 I`.
-    warmup_samples : int
-        Steps before a model may be declared stable.
-    eps, stable_s : float
-        Model stability: :math:`\\|L\\hat e\\|_\\infty < \\epsilon` for ``stable_s``.
-    var_rtol, var_stable_s : float
-        Variance stability.
-    z_threshold : float
-    repeated_samples : {"hold", "fresh"}
+class PlainRlsArxZscore(RlsArxZscore):
+    """:class:`~alfa_bench.methods.rls_arx_zscore.RlsArxZscore` stepped in plain
+    per-sample Python and NumPy; same parameters.
 
     Attributes
     ----------
@@ -167,30 +104,7 @@ class PlainRlsArxZscore(Detector):
         ``welford``, flags ``model_stable`` and ``var_stable``.
     """
 
-    def __init__(self, pairs=DEFAULT_PAIRS, rate_hz=25.0, na=1, input_window_s=1.0,
-                 p0=1e6, warmup_samples=200, eps=1e-3, stable_s=1.0, var_rtol=0.01,
-                 var_stable_s=1.0, z_threshold=4.5, repeated_samples="hold"):
-        self.pairs = pairs
-        self.rate_hz = rate_hz
-        self.na = na
-        self.input_window_s = input_window_s
-        self.p0 = p0
-        self.warmup_samples = warmup_samples
-        self.eps = eps
-        self.stable_s = stable_s
-        self.var_rtol = var_rtol
-        self.var_stable_s = var_stable_s
-        self.z_threshold = z_threshold
-        self.repeated_samples = repeated_samples
-
-    def signals(self) -> tuple[str, ...]:
-        return pair_signals(self.pairs)
-
-    def channels(self) -> tuple[str, ...]:
-        return tuple(p["name"] for p in self.pairs)
-
-    def thresholds(self) -> np.ndarray:
-        return np.full(len(self.pairs), float(self.z_threshold))
+    run = Detector.run                                 # step by step, not the compiled batch
 
     def probes(self) -> dict[str, float]:
         out = {}
