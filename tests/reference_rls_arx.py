@@ -70,9 +70,6 @@ class Welford:
         return self.m2_ / (self.n_ - 1) if self.n_ > 1 else math.nan
 
 
-_REPEATED = ("hold", "fresh")
-
-
 class _Pair:
     """State of one input/output pair."""
 
@@ -114,15 +111,9 @@ class PlainRlsArxZscore(RlsArxZscore):
         return out
 
     def reset(self) -> PlainRlsArxZscore:
-        if self.repeated_samples not in _REPEATED:
-            raise ValueError(f"repeated_samples must be one of {_REPEATED}, "
-                             f"got {self.repeated_samples!r}")
-        if self.na < 0:
-            raise ValueError(f"na must be >= 0, got {self.na}")
+        super().reset()                                # validation and step counts
         cols = {s: i for i, s in enumerate(self.signals())}
         self.pairs_ = [_Pair(self, cols[p["input"]], cols[p["output"]]) for p in self.pairs]
-        self.stable_steps_ = round(self.stable_s * self.rate_hz)
-        self.var_steps_ = round(self.var_stable_s * self.rate_hz)
         return self
 
     def update(self, x: np.ndarray, fresh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
