@@ -10,7 +10,10 @@ Prints Markdown tables (copied into BENCHMARKS.md):
    padasip's FilterRLS and statsmodels' RecursiveLS;
 2. the other per-step work: the windowed GLRT, the FF-RLS step, the Kalman filter
    (filterpy's predict/update, filterpy in steady state, our kernel);
-3. streaming latency of every configured run, one update() per 25 Hz step, against
+3. every configured run as a whole, per grid step: its plain per-sample path (the
+   reference RLS-ARX detector; the stepwise ``update()`` of the others) against its
+   compiled ``run()``;
+4. streaming latency of every configured run, one update() per 25 Hz step, against
    the 50 ms budget of a 20 Hz telemetry stream.
 
 Times are the best of ``--repeat`` runs; the first call of each compiled kernel
@@ -193,19 +196,36 @@ def other_rows(n: int, repeat: int) -> list[tuple[str, str, float]]:
     return [(what, how, t / n) for what, how, t in rows]
 
 
-def latency_rows(tmp: Path) -> list[tuple[str, float, float, float]]:
-    """Per configured run: median, 99th percentile and max of one update(), s."""
+def fitted_runs(tmp: Path):
+    """Every configured run, fitted on a synthetic corpus, with a scored flight."""
     processed = tmp / "processed"
     write_corpus(processed)
     flights = [load_flight(p) for p in sorted(processed.iterdir())]
     scored = next(f for f in flights if f.fault and f.fault.onset_s)
     config = yaml.safe_load((ROOT / "config/config.yaml").read_text())
-    rows = []
     for run, spec in config["methods"].items():
         det = make_detector(spec["detector"], spec.get("params"))
         if det.calibrated:
             det.fit(fault_free_segments(det, flights, margin_s=1.0))
-        s = sample(scored, det.signals(), det.rate_hz)
+        yield run, det, sample(scored, det.signals(), det.rate_hz)
+
+
+def detector_rows(runs, repeat: int) -> list[tuple[str, float, float]]:
+    """Per configured run: s per step of the plain per-sample path and of ``run()``."""
+    rows = []
+    for run, det, s in runs:
+        plain = (PlainRlsArxZscore(**det.get_params()) if isinstance(det, RlsArxZscore)
+                 else det)
+        det.run(s)                                      # compile
+        rows.append((run, best(lambda p=plain, s=s: Detector.run(p, s), 1) / s.t.size,
+                     best(lambda d=det, s=s: d.run(s), repeat) / s.t.size))
+    return rows
+
+
+def latency_rows(runs) -> list[tuple[str, float, float, float]]:
+    """Per configured run: median, 99th percentile and max of one update(), s."""
+    rows = []
+    for run, det, s in runs:
         det.reset()
         det.update(s.x[0], s.fresh[0])                  # compile
         det.reset()
@@ -261,10 +281,18 @@ def main() -> None:
         print("|---|---|---|")
         for what, how, t in other_rows(args.steps, args.repeat):
             print(f"| {what} | {how} | {t * 1e6:.2f} |")
+        runs = list(fitted_runs(tmp))
+        print("\n### Whole detectors, per grid step (synthetic flight, 20 Hz rows on a 25 Hz"
+              " grid)\n")
+        print("| run | plain per-sample us / step | ours `run()` us / step | plain / ours |")
+        print("|---|---|---|---|")
+        for run, plain_t, ours_t in detector_rows(runs, args.repeat):
+            print(f"| {run} | {plain_t * 1e6:.1f} | {ours_t * 1e6:.2f} | "
+                  f"{plain_t / ours_t:.0f} |")
         print("\n### Streaming latency: one `update()` per step, budget 50 ms (20 Hz)\n")
         print("| run | median ms | p99 ms | max ms | budget / p99 |")
         print("|---|---|---|---|---|")
-        for run, med, p99, worst in latency_rows(tmp):
+        for run, med, p99, worst in latency_rows(runs):
             print(f"| {run} | {med * 1e3:.3f} | {p99 * 1e3:.3f} | {worst * 1e3:.3f} | "
                   f"{0.05 / p99:.0f} |")
 

@@ -62,6 +62,7 @@ import numpy as np
 
 from alfa_bench.data import Sampled
 
+from . import kernels
 from .base import Detector
 from .glrt import WindowedGlrt, empirical_threshold, glrt_statistic
 from .rls import RecursiveLeastSquares
@@ -214,19 +215,43 @@ class FfRlsMonitor(Detector):
     def _calibration_run(self, s: Sampled, final: bool) -> dict:
         """Per model: final (theta, P) from theta = 0 (``final``), else the armed
         (residuals, parameter changes) from the a-priori values; no freezing."""
-        self._reset_models(theta0=not final)
-        out = {m["name"]: ([], []) for m in self.models}
-        for x in s.x:
-            for spec, m in zip(self.models, self.models_, strict=True):
-                eps, dtheta = self._model_step(m, x)
-                if dtheta is not None:
-                    out[spec["name"]][0].append(eps)
-                    out[spec["name"]][1].append(dtheta)
-        if final:
-            return {spec["name"]: (m.rls.theta_.copy(), m.rls.cov_.copy())
-                    for spec, m in zip(self.models, self.models_, strict=True)}
-        return {n: (np.array(e), np.array(d).reshape(-1, len(self.theta0_[n])))
-                for n, (e, d) in out.items()}
+        out = {}
+        for spec in self.models:
+            r = self._kernel_run(s, spec, from_prior=not final, freeze=False)
+            ok = np.isfinite(r["g"])
+            out[spec["name"]] = ((r["theta"], r["cov"]) if final
+                                 else (r["eps"][ok], r["dtheta"][ok]))
+        return out
+
+    def _kernel_run(self, s: Sampled, spec: dict, from_prior: bool, freeze: bool) -> dict:
+        """One model over ``s`` through :func:`~.kernels.ffrls_advance`: from the fitted
+        prior (``from_prior``) or from theta = 0, P = p0 I; with or without freezing."""
+        cols = {n: i for i, n in enumerate(s.names)}
+        u = (s.x[:, [cols[c] for c in spec["inputs"]]] - _PWM_CENTRE_US) / _PWM_HALF_RANGE_US
+        y = np.ascontiguousarray(s.x[:, cols[spec["output"]]])
+        n_par = len(spec["inputs"]) + bool(spec["autoregressive"]) + 1
+        name = spec["name"]
+        if from_prior:
+            theta, cov = self.theta0_[name].copy(), self.cov0_[name].copy()
+            max_trace = self.max_trace_ratio * float(np.trace(cov))
+        else:
+            theta, cov, max_trace = np.zeros(n_par), np.eye(n_par) * self.p0, np.inf
+        fitted = hasattr(self, "gamma_r_")
+        m, n = self._window(), s.t.size
+        r = {k: np.empty(n) for k in ("eps", "g", "t", "joint")}
+        r["dtheta"] = np.empty((n, n_par))
+        kernels.ffrls_advance(
+            np.ascontiguousarray(u), y, bool(spec["autoregressive"]), theta, cov,
+            float(self.forgetting), max_trace, np.zeros(n_par), np.zeros(n_par),
+            np.array([np.nan]), np.zeros((m + 1, n_par)), np.zeros(1, dtype=np.int64),
+            self.res_mean_[name] if fitted else 0.0, self.res_var_[name] if fitted else 1.0,
+            np.zeros(m), np.zeros(1, dtype=np.int64),
+            self.dtheta_info_[name] if fitted else np.zeros((n_par, n_par)),
+            self.gamma_r_joint_[name] if fitted else 1.0,
+            self.gamma_theta_joint_[name] if fitted else 1.0, freeze, np.zeros(1, dtype=bool),
+            r["eps"], r["dtheta"], r["g"], r["t"], r["joint"])
+        r["theta"], r["cov"], r["y"] = theta, cov, y
+        return r
 
     def fitted(self) -> dict:
         self._check_fitted("gamma_r_")
@@ -295,3 +320,19 @@ class FfRlsMonitor(Detector):
             score[2 * j], score[2 * j + 1] = g, joint
             alarm[2 * j], alarm[2 * j + 1] = g > self.gamma_r_[n], joint > 1.0
         return score, alarm
+
+    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, np.ndarray, dict]:
+        """The compiled form of :meth:`update` over ``s`` (equal to rounding)."""
+        self.reset()
+        score, kept = [], {}
+        for spec in self.models:
+            r = self._kernel_run(s, spec, from_prior=True, freeze=True)
+            score += [r["g"], r["joint"]]
+            if probes:
+                kept[f"{spec['name']}/prediction"] = r["y"] - r["eps"]
+                kept[f"{spec['name']}/residual"] = r["eps"]
+                kept[f"{spec['name']}/parameter_change"] = r["t"]
+        score = np.column_stack(score)
+        thr = self.thresholds()
+        with np.errstate(invalid="ignore"):
+            return score, score > thr, kept

@@ -1,16 +1,17 @@
 r"""Compiled (numba) kernels of the per-sample recursions.
 
 Each kernel advances a recursion over a block of steps, holding its whole state in
-arrays that the caller owns, so the same code serves streaming (a block of one step)
-and batch runs (a whole flight). The arithmetic is that of
-the plain NumPy implementations (``RecursiveLeastSquares``, and the reference
+arrays that the caller owns, so the same code can serve streaming (a block of one
+step) and batch runs (a whole flight). The arithmetic is that of the plain per-sample
+implementations it replaces (the detectors' stepwise ``update()``, and the reference
 RLS-ARX detector in ``tests/reference_rls_arx.py``); only the order of the sums in
 the dot products differs, so results agree to rounding (the tests bound it).
 
 :func:`rls_update` is one RLS step, eqs. (4)-(7) of :mod:`.rls`.
 :func:`rls_arx_advance` runs one RLS-ARX z-score pair (:mod:`.rls_arx_zscore`);
 :func:`glrt_advance` the windowed GLRT (:mod:`.glrt`); :func:`kalman_innovations` a
-steady-state Kalman filter (:mod:`.kalman_okid`).
+steady-state Kalman filter (:mod:`.kalman_okid`); :func:`ffrls_advance` one model of
+the forgetting-factor RLS monitor (:mod:`.ffrls_monitor`).
 """
 
 from __future__ import annotations
@@ -20,8 +21,8 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["ARX_FLOATS", "ARX_INTS", "glrt_advance", "kalman_innovations", "rls_arx_advance",
-           "rls_update"]
+__all__ = ["ARX_FLOATS", "ARX_INTS", "ffrls_advance", "glrt_advance", "kalman_innovations",
+           "rls_arx_advance", "rls_update"]
 
 # slots of the integer state of an RLS-ARX pair
 K, UPDATES, N_U, N_Y, STREAK_FROM, MODEL_STABLE, VAR_FROM, VAR_STABLE, W_N = range(9)
@@ -197,3 +198,62 @@ def kalman_innovations(a, b, c, d, k, u, y, skip, x, e):
             for j in range(u.shape[1]):
                 acc += b[r, j] * u[i, j]
             x[r] = acc                                 # x(k+1|k) = A x(k|k) + B u(k)
+
+
+@njit(cache=True)
+def ffrls_advance(u, y, ar, theta, cov, lam, max_trace, c_phi, gain, y_prev, thetas, n_thetas,
+                  res_mean, sigma2, glrt_buf, glrt_count, info, gamma_r_joint,
+                  gamma_theta_joint, freeze, frozen, eps, dtheta, g, t, joint):
+    """Advance one FF-RLS model of :mod:`.ffrls_monitor` over the steps of ``u``
+    (normalised deflections, shape (n, m)) and ``y`` (the rate).
+
+    State, updated in place: ``theta``, ``cov``, ``y_prev[0]`` (the last rate),
+    ``thetas`` (the last :math:`M + 1` estimates, newest first) and ``n_thetas[0]``,
+    the GLRT's ``glrt_buf``/``glrt_count``, and ``frozen[0]``. With ``freeze``,
+    adaptation stops while :math:`g > \\gamma_r'`. Per step it writes the prediction
+    error ``eps``, and once the window is full ``dtheta`` (:math:`\\hat\\theta(k) -
+    \\hat\\theta(k-M)`), the GLRT ``g``, ``t`` (:math:`T`) and ``joint``; NaN before.
+    """
+    n_par = theta.size
+    keep = thetas.shape[0]
+    phi = np.empty(n_par)
+    one = np.empty(1)
+    g_one = np.empty(1)
+    for i in range(u.shape[0]):
+        eps[i] = g[i] = t[i] = joint[i] = np.nan
+        dtheta[i, :] = np.nan
+        previous = y_prev[0]
+        y_prev[0] = y[i]
+        if ar and not math.isfinite(previous):
+            continue
+        for j in range(u.shape[1]):
+            phi[j] = u[i, j]
+        if ar:
+            phi[u.shape[1]] = previous
+        phi[n_par - 1] = 1.0
+        if frozen[0]:
+            e = y[i]
+            for j in range(n_par):
+                e -= phi[j] * theta[j]                 # (14) with theta held
+        else:
+            e = rls_update(theta, cov, phi, y[i], lam, max_trace, c_phi, gain)  # (14)-(16)
+        eps[i] = e
+        for r in range(keep - 1, 0, -1):
+            thetas[r, :] = thetas[r - 1, :]
+        thetas[0, :] = theta
+        n_thetas[0] = min(n_thetas[0] + 1, keep)
+        if n_thetas[0] < keep:
+            continue
+        for j in range(n_par):
+            dtheta[i, j] = thetas[0, j] - thetas[keep - 1, j]  # theta(k) - theta(k - M)
+        one[0] = e - res_mean
+        glrt_advance(one, glrt_buf, glrt_count, sigma2, g_one)
+        g[i] = g_one[0]
+        tt = 0.0
+        for a in range(n_par):
+            for b in range(n_par):
+                tt += dtheta[i, a] * info[a, b] * dtheta[i, b]  # T = dtheta' Sigma^-1 dtheta
+        t[i] = tt
+        if freeze:
+            frozen[0] = g[i] > gamma_r_joint           # stop adapting while residual test is up
+        joint[i] = min(g[i] / gamma_r_joint, tt / gamma_theta_joint)
