@@ -26,6 +26,7 @@ rule all:
         rules.runtime.output,
         rules.sweep.output,
         rules.figures.output,
+        rules.flight_figures.output,
         rules.readme_figure.output,
         rules.rerun_logs.output,
         rules.paper_sources.output,

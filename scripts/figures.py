@@ -1,13 +1,10 @@
-"""Snakemake script: the sweep, detection-time and per-flight figures."""
-
-from pathlib import Path
+"""Snakemake script: the sweep and detection-time figures."""
 
 import pandas as pd
 
 from alfa_bench.analysis import read_records
-from alfa_bench.analysis.figures import detection_time_figure, flight_figure, sweep_figure
+from alfa_bench.analysis.figures import detection_time_figure, sweep_figure
 from alfa_bench.analysis.logs import log_to
-from alfa_bench.analysis.traces import read_traces
 from alfa_bench.data import read_manifest, subset_flights
 
 sm = snakemake  # noqa: F821
@@ -17,10 +14,3 @@ manifest = read_manifest(sm.input.manifest)
 records = read_records(sm.input.detections)
 sweep_figure(pd.read_csv(sm.input.sweep), subset, sm.output.sweep)
 detection_time_figure(records, subset_flights(manifest, subset), sm.output.detection_time)
-traces = read_traces(sm.input.traces)
-methods = list(dict.fromkeys(r["method"] for r in records))
-for rec in (r for r in records if r["method"] == methods[0]):
-    flight = rec["flight"]
-    flight_figure(flight, rec["onset_s"], rec["fault_end_s"],
-                  {m: traces[m, flight] for m in methods},
-                  Path(sm.output.flights) / f"{flight}.png")

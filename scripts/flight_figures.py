@@ -1,0 +1,19 @@
+"""Snakemake script: per flight, every method's score / threshold around the onset."""
+
+from pathlib import Path
+
+from alfa_bench.analysis import read_records
+from alfa_bench.analysis.figures import flight_figure
+from alfa_bench.analysis.logs import log_to
+from alfa_bench.analysis.traces import read_traces
+
+sm = snakemake  # noqa: F821
+log_to(sm.log[0])
+records = read_records(sm.input.detections)
+traces = read_traces(sm.input.traces)
+methods = list(dict.fromkeys(r["method"] for r in records))
+for rec in (r for r in records if r["method"] == methods[0]):
+    flight = rec["flight"]
+    flight_figure(flight, rec["onset_s"], rec["fault_end_s"],
+                  {m: traces[m, flight] for m in methods},
+                  Path(sm.output[0]) / f"{flight}.png")
