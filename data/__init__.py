@@ -1,14 +1,22 @@
 """ALFA data layer: flights, signals, manifest, download."""
 
 from .download import fetch_alfa, processed_dir, resolve_alfa_dir
-from .errors import AlfaDataError, MissingTopicError
+from .errors import FAILURE_COLUMNS, AlfaDataError, MissingTopicError, failure_row
 from .flight import FAULT_CLASSES, Fault, Flight, Topic, find_flights, load_flight
-from .manifest import SUBSETS, build_manifest, read_manifest, subset_flights
-from .signals import SIGNALS, Sampled, Signal, sample, series
+from .manifest import (
+    SUBSETS,
+    build_manifest,
+    name_subsets,
+    read_manifest,
+    scan_flights,
+    subset_flights,
+)
+from .signals import MAX_HOLD_S, SIGNALS, Sampled, Signal, sample, series
 
 __all__ = [
-    "FAULT_CLASSES", "SIGNALS", "SUBSETS", "AlfaDataError", "Fault", "Flight",
-    "MissingTopicError", "Sampled", "Signal", "Topic", "build_manifest", "fetch_alfa",
-    "find_flights", "load_flight", "processed_dir", "read_manifest", "resolve_alfa_dir",
-    "sample", "series", "subset_flights",
+    "FAILURE_COLUMNS", "FAULT_CLASSES", "MAX_HOLD_S", "SIGNALS", "SUBSETS", "AlfaDataError",
+    "Fault", "Flight", "MissingTopicError", "Sampled", "Signal", "Topic", "build_manifest",
+    "failure_row", "fetch_alfa", "find_flights", "load_flight", "name_subsets",
+    "processed_dir", "read_manifest", "resolve_alfa_dir", "sample", "scan_flights", "series",
+    "subset_flights",
 ]

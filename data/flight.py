@@ -16,7 +16,13 @@ Bad input policy (also in the README):
   ``%time`` that is not an integer, timestamps that go backwards, a
   non-numeric, NaN or infinite cell in a column that is used, a
   ``failure_status`` topic without rows, a ground-truth topic that is not one of
-  ALFA's four, a ``no_failure`` flight with ground truth rows;
+  ALFA's four, a ``no_failure`` flight with ground truth rows, a label naming
+  control surfaces other than its ground-truth topics, a row more than
+  :data:`MAX_OUTSIDE_S` before the topics' median first row or after their median
+  last row (a clock jump or a stray row that would move the flight clock or the
+  onset);
+- logged and kept: a label that names no fault class ALFA knows (the class is
+  then read from the ground-truth topics alone);
 - repaired and logged (warning on the ``alfa_bench.data`` logger, and kept in
   :attr:`Flight.repairs` so that results record it): a last line cut short
   (no final newline, as left by an interrupted copy) is dropped; rows that repeat
@@ -39,6 +45,7 @@ from .errors import AlfaDataError, MissingTopicError
 
 __all__ = [
     "FAULT_CLASSES",
+    "MAX_OUTSIDE_S",
     "Fault",
     "Flight",
     "Topic",
@@ -58,6 +65,12 @@ _GROUND_TRUTH_TOPICS = {
     "failure_status-rudder": "rudder",
     "failure_status-aileron": "aileron",
 }
+
+#: How far a row may lie outside the flight's span (the topics' median first and
+#: last rows), s. In ALFA every topic starts and ends within 0.3 s of the median.
+MAX_OUTSIDE_S = 60.0
+
+_LABEL_CLASSES = re.compile(r"engine|rudder|elevator|aileron")
 
 _FLIGHT_NAME = re.compile(
     r"^carbonZ_(?P<date>\d{4}-\d{2}-\d{2})-(?P<time>\d{2}-\d{2}-\d{2})"
@@ -255,6 +268,7 @@ def load_flight(path: str | Path) -> Flight:
         raw[topic] = (f.name, t_ns, frame, lines)
     if not raw:
         raise AlfaDataError("no topic files (<flight>-<topic>.csv)", flight=name)
+    _check_span(name, raw)
 
     t0 = min(int(v[1][0]) for v in raw.values())
     topics = {
@@ -295,6 +309,7 @@ def _ground_truth(flight: str, label: str, topics: dict[str, Topic]) -> Fault | 
                             flight=flight, file=f"{flight}-{gt[0]}.csv")
     order = list(_GROUND_TRUTH_TOPICS)
     gt.sort(key=order.index)
+    _check_label(flight, label, {_GROUND_TRUTH_TOPICS[t] for t in gt}, gt)
     codes = {t: tuple(dict.fromkeys(topics[t].values("field.data").astype(int).tolist()))
              for t in gt}
     return Fault(
@@ -304,6 +319,32 @@ def _ground_truth(flight: str, label: str, topics: dict[str, Topic]) -> Fault | 
         topics=tuple(gt),
         codes=codes,
     )
+
+
+def _check_span(flight: str, raw: dict[str, tuple]) -> None:
+    first = np.median([int(v[1][0]) for v in raw.values()])
+    last = np.median([int(v[1][-1]) for v in raw.values()])
+    lo, hi = first - MAX_OUTSIDE_S * 1e9, last + MAX_OUTSIDE_S * 1e9
+    for file, t_ns, _, lines in raw.values():
+        out = (t_ns < lo) | (t_ns > hi)
+        if out.any():
+            i = int(np.argmax(out))
+            where = (f"{(first - t_ns[i]) * 1e-9:.0f} s before the topics' median first row"
+                     if t_ns[i] < lo else
+                     f"{(t_ns[i] - last) * 1e-9:.0f} s after the topics' median last row")
+            raise AlfaDataError(f"%time {t_ns[i]} is {where} (limit {MAX_OUTSIDE_S:.0f} s)",
+                                flight=flight, file=file, column="%time", line=int(lines[i]))
+
+
+def _check_label(flight: str, label: str, classes: set[str], gt: list[str]) -> None:
+    named = set(_LABEL_CLASSES.findall(label))
+    if not named:
+        log.warning("flight %s: label %r names no known fault class; the class is read from "
+                    "the ground-truth topics (%s)", flight, label, ", ".join(sorted(classes)))
+    elif named != classes:
+        raise AlfaDataError(f"label {label!r} names {', '.join(sorted(named))} but the "
+                            f"ground-truth topics name {', '.join(sorted(classes))}",
+                            flight=flight, file=f"{flight}-{gt[0]}.csv")
 
 
 def _read_topic(path: Path, flight: str, repairs: list[str]):

@@ -6,7 +6,11 @@ Detectors ask for signals by name (``roll_cmd``, ``roll_error``, ...) and a rate
 Sampling is a causal zero-order hold: the value at :math:`t_k` is that of the
 latest row with record time :math:`\\le t_k`. Nothing after :math:`t_k` is used,
 so no interpolation; the grid covers only the span where every requested topic
-has started and none has ended.
+has started and none has ended. No value is held longer than ``max_hold_s``
+(default :data:`MAX_HOLD_S`): a gap in a topic's rows, or a topic so slow that its
+rows are further apart, is an :class:`AlfaDataError` naming the rows, since a
+detector fed a stale value would score data that does not exist. (In the ALFA
+flights the longest step between rows of a used topic is 0.54 s, in ``rc-out``.)
 
 ALFA topics are sample-and-hold streams (``nav_info`` roll and pitch rows come at
 ~19.5 Hz, but the measured value changes at ~2.5 Hz). :func:`sample` therefore
@@ -23,7 +27,10 @@ import numpy as np
 from .errors import AlfaDataError
 from .flight import Flight
 
-__all__ = ["SIGNALS", "Sampled", "Signal", "sample", "series"]
+__all__ = ["MAX_HOLD_S", "SIGNALS", "Sampled", "Signal", "sample", "series"]
+
+#: The longest a row's value may be held on the sampling grid, s.
+MAX_HOLD_S = 1.0
 
 
 @dataclass(frozen=True)
@@ -104,7 +111,8 @@ def series(flight: Flight, name: str) -> tuple[np.ndarray, np.ndarray]:
     return tp.t, value - tp.values(sig.minus) if sig.minus else value
 
 
-def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float) -> Sampled:
+def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float,
+           max_hold_s: float = MAX_HOLD_S) -> Sampled:
     """Sample the named signals of ``flight`` at ``rate_hz`` (causal hold)."""
     names = tuple(names)
     unknown = [n for n in names if n not in SIGNALS]
@@ -119,6 +127,8 @@ def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float) -
     if t.size == 0:
         raise AlfaDataError(f"signals {list(names)} never overlap in time", flight=flight.id)
 
+    for tp in dict.fromkeys(topics):
+        _check_hold(flight, tp, t, max_hold_s)
     x = np.empty((t.size, len(names)))
     fresh = np.empty((t.size, len(names)), dtype=bool)
     for j, (name, tp) in enumerate(zip(names, topics, strict=True)):
@@ -130,3 +140,18 @@ def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float) -
         source = last_change[row]
         fresh[:, j] = np.r_[True, source[1:] != source[:-1]]
     return Sampled(t=t, x=x, fresh=fresh, names=names)
+
+
+def _check_hold(flight: Flight, tp, t: np.ndarray, max_hold_s: float) -> None:
+    """Refuse a grid ``t`` on which a row of ``tp`` would be held over ``max_hold_s``."""
+    row = np.searchsorted(tp.t, t, side="right") - 1
+    age = t - tp.t[row]
+    if age.max() <= max_hold_s:
+        return
+    i = int(row[np.argmax(age > max_hold_s)])
+    median = float(np.median(np.diff(tp.t))) if tp.t.size > 1 else float("nan")
+    raise AlfaDataError(
+        f"no row for {tp.t[i + 1] - tp.t[i]:.2f} s (from {tp.t[i]:.2f} s to {tp.t[i + 1]:.2f} s "
+        f"on the flight clock; the topic's median period is {median:.2f} s): a value would "
+        f"be held longer than {max_hold_s} s", flight=flight.id, file=tp.file, column="%time",
+        line=int(tp.lines[i + 1]))

@@ -105,6 +105,15 @@ def write_flight(processed: Path, name: str, *, duration_s: float = 80.0, rate_h
     return folder
 
 
+def rename_flight(folder: Path, name: str) -> Path:
+    """Rename flight ``folder`` and its files to ``name``; return the new folder."""
+    new = folder.with_name(name)
+    folder.rename(new)
+    for f in new.iterdir():
+        f.rename(new / f.name.replace(folder.name, name, 1))
+    return new
+
+
 def write_corpus(processed: Path) -> dict[str, Path]:
     """A small corpus: fault flights of several classes, fault-free, emr, late."""
     specs = {

@@ -5,6 +5,7 @@ import pytest
 
 from alfa_bench.data import AlfaDataError, MissingTopicError, find_flights, load_flight
 from alfa_bench.data.flight import parse_flight_name
+from synthetic import rename_flight
 
 
 def test_clock_onset_class_and_label(one_flight):
@@ -33,6 +34,8 @@ def test_fault_free_flight_has_class_none(corpus):
 
 
 def test_combined_fault_is_named_rudder_plus_aileron(one_flight):
+    one_flight = rename_flight(one_flight,
+                               "carbonZ_2018-09-11-17-27-13_1_rudder_zero__left_aileron_failure")
     name = one_flight.name
     gt = one_flight / f"{name}-failure_status-engines.csv"
     gt.rename(one_flight / f"{name}-failure_status-aileron.csv")
