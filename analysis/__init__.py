@@ -1,7 +1,13 @@
 """Scoring, tables and provenance of detector runs."""
 
 from .calibration import folds
-from .detections import detect_all, detection_record, read_records, write_record
+from .detections import (
+    detect_all,
+    detection_record,
+    read_failures,
+    read_records,
+    write_record,
+)
 from .scoring import OUTCOMES, flight_outcome, summarize
 from .tables import (
     by_fault_latex,
@@ -10,6 +16,7 @@ from .tables import (
     comparison_latex,
     comparison_markdown,
     comparison_table,
+    failures_table,
     summary_latex,
     summary_markdown,
     summary_table,
@@ -17,5 +24,6 @@ from .tables import (
 
 __all__ = ["OUTCOMES", "by_fault_latex", "by_fault_markdown", "by_fault_table",
            "comparison_latex", "comparison_markdown", "comparison_table", "detect_all",
-           "detection_record", "flight_outcome", "folds", "read_records", "summarize",
+           "detection_record", "failures_table", "flight_outcome", "folds", "read_failures",
+           "read_records", "summarize",
            "summary_latex", "summary_markdown", "summary_table", "write_record"]

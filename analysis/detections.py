@@ -3,6 +3,10 @@
 The record is what ``results/detections/{method}/{flight}.json`` holds. A calibrated
 method is fitted once per fold of :func:`~.calibration.folds`, on the fault-free data
 of the other folds' flights only, and each record names those flights.
+
+A flight the method cannot read (a topic it needs is missing, a gap in its rows)
+is either the end of the run (strict) or a failure row: the flight then gives
+neither a record nor calibration data, and the failure is logged.
 """
 
 from __future__ import annotations
@@ -14,7 +18,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from alfa_bench.data import Flight
+from alfa_bench.data import AlfaDataError, Flight, failure_row
 from alfa_bench.methods import (
     Detector,
     Trace,
@@ -27,30 +31,58 @@ from .calibration import folds
 from .provenance import provenance
 from .scoring import flight_outcome
 
-__all__ = ["detect_all", "detection_record", "read_records", "write_record"]
+__all__ = ["detect_all", "detection_record", "read_failures", "read_records", "write_record"]
 
 log = logging.getLogger(__name__)
 
 
 def detect_all(method: str, spec: dict, flights: dict[str, Flight], manifest: pd.DataFrame,
-               calibration: dict) -> Iterator[tuple[dict, Trace]]:
+               calibration: dict, failures: list[dict] | None = None
+               ) -> Iterator[tuple[dict, Trace]]:
     """Records and traces (with probes) of ``spec`` (``{"detector": name, "params":
     {...}}``) on every flight of ``manifest`` with ground truth; ``calibration`` is
-    ``{"group_by", "margin_s"}``."""
+    ``{"group_by", "margin_s"}``.
+
+    With ``failures`` None, a flight that cannot be read raises its
+    :class:`~alfa_bench.data.AlfaDataError`; with a list, the flight is skipped and a
+    :func:`~alfa_bench.data.failure_row` appended, once per flight.
+    """
     detector = make_detector(spec["detector"], spec.get("params"))
     sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
+    failed: set[str] = set()
+
+    def guarded(stage: str, name: str, fn):
+        if name in failed:
+            return None
+        try:
+            return fn()
+        except AlfaDataError as e:
+            if failures is None:
+                raise
+            failed.add(name)
+            failures.append(failure_row(e, stage, method))
+            log.error("%s: flight %s excluded at %s: %s", method, name, stage, e)
+            return None
+
+    def run(name: str, info: dict | None = None):
+        return guarded("detect", name, lambda: detection_record(
+            method, spec, detector, flights[name], sha[name], info))
+
     if not detector.calibrated:
         for name in manifest.loc[manifest["ground_truth"], "flight"]:
-            yield detection_record(method, spec, detector, flights[name], sha[name])
+            if (out := run(name)) is not None:
+                yield out
         return
     for fold, (scored, training) in folds(manifest, calibration["group_by"]).items():
-        detector.fit(fault_free_segments(detector, [flights[f] for f in training],
-                                         calibration["margin_s"]))
-        log.info("%s: fold %s fitted on %d flights", method, fold, len(training))
-        info = {**calibration, "fold": fold, "flights": list(training),
-                "fitted": detector.fitted()}
+        segments = {f: guarded("calibration", f, lambda f=f: fault_free_segments(
+            detector, [flights[f]], calibration["margin_s"])) for f in training}
+        used = [f for f in training if segments[f] is not None]
+        detector.fit([s for f in used for s in segments[f]])
+        log.info("%s: fold %s fitted on %d flights", method, fold, len(used))
+        info = {**calibration, "fold": fold, "flights": used, "fitted": detector.fitted()}
         for name in scored:
-            yield detection_record(method, spec, detector, flights[name], sha[name], info)
+            if (out := run(name, info)) is not None:
+                yield out
 
 
 def detection_record(method: str, spec: dict, detector: Detector, flight: Flight,
@@ -96,3 +128,9 @@ def write_record(record: dict, path: Path) -> None:
 def read_records(folders) -> list[dict]:
     """All records in the given ``results/detections/{method}`` folders."""
     return [json.loads(p.read_text()) for d in folders for p in sorted(Path(d).glob("*.json"))]
+
+
+def read_failures(folders) -> list[pd.DataFrame]:
+    """The ``failures.csv`` of each ``results/detections/{method}`` folder."""
+    return [pd.read_csv(Path(d) / "failures.csv", dtype=str, keep_default_na=False)
+            for d in folders]

@@ -72,7 +72,8 @@ def sweep_table(records: list[dict], traces: dict[tuple[str, str], Trace],
     for subset in subsets:
         flights = subset_flights(manifest, subset)
         for method in methods:
-            cs = [curves[method, f] for f in flights]
+            # an excluded flight has no curve (the tables count it)
+            cs = [curves[method, f] for f in flights if (method, f) in curves]
             hours = sum(c["free_s"] for _, c in cs) / 3600.0
             events = np.sum([c["events"] for _, c in cs], axis=0)
             for i, kappa in enumerate(scales):

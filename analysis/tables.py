@@ -6,6 +6,10 @@ with the false alarms on fault-free flights, how each was calibrated, and on how
 flights it armed (judged at all: a method that never arms has no false alarms).
 ``by_fault``: the layout of Keipour et al.'s Table I per method and subset: fault
 class, flights, flight time, mean and max detection time, accuracy, and a total row.
+
+A flight that could not be read (for every method, or for one) is not scored; the
+``excluded`` column of the summary and comparison counts such flights of the subset,
+and ``results/tables/failures.csv`` (:func:`failures_table`) says why.
 """
 
 from __future__ import annotations
@@ -14,40 +18,66 @@ import math
 
 import pandas as pd
 
-from alfa_bench.data import subset_flights
+from alfa_bench.data import FAILURE_COLUMNS, subset_flights
 
 from .reference import ICRA2019_BY_FAULT, ICRA2019_NAME, ICRA2019_SUMMARY
 from .scoring import summarize
 
 __all__ = ["FAULT_ORDER", "by_fault_latex", "by_fault_markdown", "by_fault_table",
-           "comparison_latex", "comparison_markdown", "comparison_table", "latex_escape",
+           "comparison_latex", "comparison_markdown", "comparison_table", "failures_table",
+           "latex_escape",
            "summary_latex", "summary_markdown", "summary_table"]
 
 FAULT_ORDER = ("engine", "rudder", "elevator", "aileron", "rudder+aileron", "none")
 
 
-def _records_for(records: list[dict], manifest: pd.DataFrame, subset: str) -> dict:
-    """method -> records of the subset's flights; every flight must have one."""
+def failures_table(load: pd.DataFrame, per_method: list[pd.DataFrame]) -> pd.DataFrame:
+    """Every flight given up: at load (for every method) and per method, in that order."""
+    frames = [f for f in [load, *per_method] if len(f)]
+    if not frames:
+        return pd.DataFrame(columns=[*FAILURE_COLUMNS, "subsets"])
+    return pd.concat(frames, ignore_index=True).reindex(columns=[*FAILURE_COLUMNS, "subsets"])
+
+
+def _excluded(failures: pd.DataFrame | None, subset: str, flights: list[str],
+              method: str) -> list[str]:
+    if failures is None or not len(failures):
+        return []
+    f = failures.fillna("")
+    at_load = f[(f["stage"] == "load") & f["subsets"].astype(str).str.split(";").apply(
+        lambda s: subset in s)]["flight"]
+    member = set(flights)
+    own = f[(f["method"] == method) & f["flight"].isin(member)]["flight"]
+    return list(dict.fromkeys([*at_load, *own]))
+
+
+def _records_for(records: list[dict], manifest: pd.DataFrame, subset: str,
+                 failures: pd.DataFrame | None = None) -> dict[str, tuple[list[dict], list[str]]]:
+    """method -> (records of the subset's flights, the subset's flights it excluded);
+    a flight without a record must be one of ``failures``."""
     flights = subset_flights(manifest, subset)
     by_method: dict[str, dict[str, dict]] = {}
     for r in records:
         by_method.setdefault(r["method"], {})[r["flight"]] = r
     out = {}
     for method, recs in by_method.items():
-        missing = [f for f in flights if f not in recs]
+        excluded = _excluded(failures, subset, flights, method)
+        missing = [f for f in flights if f not in recs and f not in excluded]
         if missing:
             raise ValueError(f"method {method}: no detection for {len(missing)} flight(s) of "
-                             f"subset {subset}, e.g. {missing[0]}")
-        out[method] = [recs[f] for f in flights]
+                             f"subset {subset}, e.g. {missing[0]}, and no failure reported")
+        out[method] = ([recs[f] for f in flights if f in recs], excluded)
     return out
 
 
-def summary_table(records: list[dict], manifest: pd.DataFrame, subsets) -> pd.DataFrame:
+def summary_table(records: list[dict], manifest: pd.DataFrame, subsets,
+                  failures: pd.DataFrame | None = None) -> pd.DataFrame:
     rows = []
     for subset in subsets:
-        for method, recs in _records_for(records, manifest, subset).items():
+        for method, (recs, excluded) in _records_for(records, manifest, subset,
+                                                     failures).items():
             s = summarize([r["outcome"] for r in recs], [r["detection_s"] for r in recs])
-            rows.append({"method": method, "subset": subset, **s})
+            rows.append({"method": method, "subset": subset, **s, "excluded": len(excluded)})
     return pd.DataFrame(rows)
 
 
@@ -56,12 +86,14 @@ def _calibration(rec: dict) -> str:
     return f"leave-one-{cal['group_by']}-out" if cal else "none"
 
 
-def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets) -> pd.DataFrame:
-    """Per subset and method: the scores, false alarms on fault-free flights, and the
-    calibration protocol."""
+def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets,
+                     failures: pd.DataFrame | None = None) -> pd.DataFrame:
+    """Per subset and method: the scores, false alarms on fault-free flights, the
+    calibration protocol, and the flights excluded."""
     rows = []
     for subset in subsets:
-        for method, recs in _records_for(records, manifest, subset).items():
+        for method, (recs, excluded) in _records_for(records, manifest, subset,
+                                                     failures).items():
             s = summarize([r["outcome"] for r in recs], [r["detection_s"] for r in recs])
             free = [r for r in recs if r["fault_class"] == "none"]
             rows.append({
@@ -74,15 +106,17 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets) -> pd
                 "fault_free_false_alarms": sum(r["outcome"] == "FP" for r in free),
                 "armed_flights": sum(any(v is not None for v in r["pair_armed_s"].values())
                                      for r in recs),
+                "excluded": len(excluded),
             })
     return pd.DataFrame(rows)
 
 
-def by_fault_table(records: list[dict], manifest: pd.DataFrame, subsets) -> pd.DataFrame:
+def by_fault_table(records: list[dict], manifest: pd.DataFrame, subsets,
+                   failures: pd.DataFrame | None = None) -> pd.DataFrame:
     info = manifest.set_index("flight")
     rows = []
     for subset in subsets:
-        for method, recs in _records_for(records, manifest, subset).items():
+        for method, (recs, _) in _records_for(records, manifest, subset, failures).items():
             groups = {c: [r for r in recs if r["fault_class"] == c] for c in FAULT_ORDER}
             groups["total"] = recs
             for fault_class, group in groups.items():
@@ -154,12 +188,12 @@ def _latex(sections: list[Section], label: str) -> str:
 
 
 def _summary_sections(summary: pd.DataFrame) -> list[Section]:
-    header = ["method", "flights", "TP", "FP", "FN", "TN", "precision %", "recall %",
-              "accuracy %", "mean det. s", "max det. s"]
+    header = ["method", "flights", "excluded", "TP", "FP", "FN", "TN", "precision %",
+              "recall %", "accuracy %", "mean det. s", "max det. s"]
 
     def cells(name, s):
-        return [name, str(s["flights"]), str(s["tp"]), str(s["fp"]), str(s["fn"]),
-                str(s["tn"]), _fmt(s["precision"], True), _fmt(s["recall"], True),
+        return [name, str(s["flights"]), _fmt(s.get("excluded")), str(s["tp"]), str(s["fp"]),
+                str(s["fn"]), str(s["tn"]), _fmt(s["precision"], True), _fmt(s["recall"], True),
                 _fmt(s["accuracy"], True), _fmt(s["mean_detection_s"]),
                 _fmt(s["max_detection_s"])]
 
@@ -198,14 +232,14 @@ def _by_fault_sections(by_fault: pd.DataFrame) -> list[Section]:
 def _comparison_sections(comparison: pd.DataFrame) -> list[Section]:
     header = ["method", "detector", "calibration", "precision %", "recall %", "accuracy %",
               "mean det. s", "max det. s", "false alarms, fault-free flights",
-              "flights armed"]
+              "flights armed", "flights excluded"]
 
     def cells(r):
         return [r["method"], r["detector"], r["calibration"], _fmt(r["precision"], True),
                 _fmt(r["recall"], True), _fmt(r["accuracy"], True),
                 _fmt(r["mean_detection_s"]), _fmt(r["max_detection_s"]),
                 f"{r['fault_free_false_alarms']} of {r['fault_free_flights']}",
-                _fmt(r.get("armed_flights"))]
+                _fmt(r.get("armed_flights")), _fmt(r.get("excluded"))]
 
     out = []
     for subset, table in comparison.groupby("subset", sort=False):
@@ -216,8 +250,10 @@ def _comparison_sections(comparison: pd.DataFrame) -> list[Section]:
             rows.append(cells({**paper, "method": ICRA2019_NAME, "detector": "rls_arx_zscore",
                                "calibration": "(as published)", "fault_free_flights": free,
                                "fault_free_false_alarms": free - paper["tn"],
-                               "armed_flights": None}))
-        flights = int(table["flights"].iloc[0])
+                               "armed_flights": None, "excluded": None}))
+        # the subset's size: the first method's scored and excluded flights
+        first = table.iloc[0]
+        flights = int(first["flights"]) + int(first.get("excluded", 0))
         out.append((f"Subset `{subset}` ({flights} flights)", header, rows))
     return out
 

@@ -6,7 +6,10 @@ line, so that a broken input can be found without a debugger.
 
 from __future__ import annotations
 
-__all__ = ["AlfaDataError", "MissingTopicError"]
+__all__ = ["FAILURE_COLUMNS", "AlfaDataError", "MissingTopicError", "failure_row"]
+
+#: Columns of a failures table: where a flight was given up, and why.
+FAILURE_COLUMNS = ["flight", "stage", "method", "file", "column", "line", "error"]
 
 
 class AlfaDataError(ValueError):
@@ -44,3 +47,11 @@ class AlfaDataError(ValueError):
 
 class MissingTopicError(AlfaDataError):
     """A topic a method needs has no CSV file in the flight folder."""
+
+
+def failure_row(error: AlfaDataError, stage: str, method: str = "") -> dict:
+    """A row of a failures table for ``error``, raised at ``stage`` (``load``,
+    ``calibration``, ``detect``) of ``method`` (empty for all methods)."""
+    return {"flight": error.flight or "", "stage": stage, "method": method,
+            "file": error.file or "", "column": error.column or "",
+            "line": "" if error.line is None else error.line, "error": str(error)}

@@ -12,12 +12,17 @@ Subsets (a flight may be in several):
     commands change at the fault (reported apart, as the ALFA notes advise).
 
 Nothing here lists flights by name: the subsets are rules over what is found.
+
+A flight that cannot be read is not in the manifest. :func:`scan_flights` reports
+it as a failure row instead (with the subsets its name says it would have been
+in, so the tables can show it as excluded); :func:`build_manifest` stops at it.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+import logging
 import math
 from importlib import resources
 from pathlib import Path
@@ -25,11 +30,14 @@ from pathlib import Path
 import jsonschema
 import pandas as pd
 
-from .errors import AlfaDataError
+from .errors import FAILURE_COLUMNS, AlfaDataError, failure_row
 from .flight import Flight, find_flights, load_flight, parse_flight_name
 
 __all__ = ["ICRA22_LAST_DATE", "SUBSETS", "build_manifest", "flight_sha256", "manifest_row",
-           "read_manifest", "subset_flights", "validate_manifest"]
+           "name_subsets", "read_manifest", "scan_flights", "subset_flights",
+           "validate_manifest"]
+
+log = logging.getLogger("alfa_bench.data")
 
 ICRA22_LAST_DATE = "2018-09-11"
 
@@ -90,8 +98,41 @@ def manifest_row(flight: Flight) -> dict:
     return row
 
 
+def name_subsets(flight: str) -> str:
+    """The subsets a flight's name puts it in, were its ground truth readable
+    (empty for a name that is not an ALFA flight name)."""
+    try:
+        meta = parse_flight_name(flight)
+    except AlfaDataError:
+        return ""
+    row = {"ground_truth": meta["label"] != "no_ground_truth", "date": meta["date"],
+           "emergency_trajectory": str(meta["label"]).endswith("with_emr_traj")}
+    return ";".join(name for name, rule in SUBSETS.items() if rule(row))
+
+
+def scan_flights(processed: str | Path) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Load every flight under ``processed``: the validated manifest of those that
+    load, and a failures table (:data:`~.errors.FAILURE_COLUMNS` and ``subsets``)
+    of those that do not, each also logged."""
+    rows, failures = [], []
+    for path in find_flights(Path(processed)):
+        try:
+            rows.append(manifest_row(load_flight(path)))
+        except AlfaDataError as e:
+            log.error("flight %s excluded: %s", path.name, e)
+            failures.append({**failure_row(e, "load"), "flight": path.name,
+                             "subsets": name_subsets(path.name)})
+    if not rows:
+        raise AlfaDataError(f"no readable flights under {processed} "
+                            f"({len(failures)} could not be read)")
+    manifest = pd.DataFrame(rows, columns=COLUMNS)
+    validate_manifest(manifest)
+    return manifest, pd.DataFrame(failures, columns=[*FAILURE_COLUMNS, "subsets"])
+
+
 def build_manifest(processed: str | Path) -> pd.DataFrame:
-    """Load every flight under ``processed`` and return the validated manifest."""
+    """Load every flight under ``processed`` and return the validated manifest;
+    the first flight that cannot be read raises its :class:`AlfaDataError`."""
     rows = [manifest_row(load_flight(p)) for p in find_flights(Path(processed))]
     if not rows:
         raise AlfaDataError(f"no flights found under {processed}")

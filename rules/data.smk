@@ -15,9 +15,11 @@ rule manifest:
     input:
         PROCESSED,
     output:
-        "data/flights.csv",
+        manifest="data/flights.csv",
+        failures="data/load_failures.csv",
     params:
         processed=str(PROCESSED),
+        strict=config["strict"],
     log:
         "results/logs/manifest.log",
     script:

@@ -12,6 +12,7 @@ rule detect:
         spec=lambda w: json.dumps(config["methods"][w.method], sort_keys=True),
         processed=str(PROCESSED),
         calibration=config["calibration"],
+        strict=config["strict"],
     log:
         "results/logs/detect/{method}.log",
     benchmark:

@@ -1,8 +1,10 @@
 rule tables:
     input:
         manifest="data/flights.csv",
+        load_failures="data/load_failures.csv",
         detections=expand("results/detections/{method}", method=METHODS),
     output:
+        failures=report("results/tables/failures.csv", category="Tables"),
         summary="results/tables/summary.csv",
         by_fault="results/tables/by_fault.csv",
         comparison=report("results/tables/comparison.csv", category="Tables"),

@@ -12,8 +12,9 @@ log_to(sm.log[0])
 records = read_records(sm.input.detections)
 traces = read_traces(sm.input.traces)
 methods = list(dict.fromkeys(r["method"] for r in records))
-for rec in (r for r in records if r["method"] == methods[0]):
+# a flight a method excluded is drawn without it
+for rec in {r["flight"]: r for r in records}.values():
     flight = rec["flight"]
     flight_figure(flight, rec["onset_s"], rec["fault_end_s"],
-                  {m: traces[m, flight] for m in methods},
+                  {m: traces[m, flight] for m in methods if (m, flight) in traces},
                   Path(sm.output[0]) / f"{flight}.png")

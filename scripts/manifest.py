@@ -1,8 +1,17 @@
-"""Snakemake script: build data/flights.csv from the flights found."""
+"""Snakemake script: build data/flights.csv from the flights found, and
+data/load_failures.csv from those that cannot be read (strict: stop at the first)."""
+
+import pandas as pd
 
 from alfa_bench.analysis.logs import log_to
-from alfa_bench.data import build_manifest
+from alfa_bench.data import FAILURE_COLUMNS, build_manifest, scan_flights
 
-log_to(snakemake.log[0])  # noqa: F821
-manifest = build_manifest(snakemake.params.processed)  # noqa: F821
-manifest.to_csv(snakemake.output[0], index=False)  # noqa: F821
+sm = snakemake  # noqa: F821
+log_to(sm.log[0])
+if sm.params.strict:
+    manifest = build_manifest(sm.params.processed)
+    failures = pd.DataFrame(columns=[*FAILURE_COLUMNS, "subsets"])
+else:
+    manifest, failures = scan_flights(sm.params.processed)
+manifest.to_csv(sm.output.manifest, index=False)
+failures.to_csv(sm.output.failures, index=False)

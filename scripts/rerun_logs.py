@@ -21,5 +21,5 @@ traces = read_traces(sm.input.traces)
 out = Path(sm.output[0])
 for flight in manifest.loc[manifest["ground_truth"], "flight"]:
     write_rerun_log(load_flight(Path(sm.params.processed) / flight),
-                    {m: traces[m, flight] for m in order}, signals, out / f"{flight}.rrd")
+                    {m: traces[m, flight] for m in order if (m, flight) in traces}, signals, out / f"{flight}.rrd")
     logging.info("%s: written", flight)

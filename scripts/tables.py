@@ -2,6 +2,8 @@
 
 from pathlib import Path
 
+import pandas as pd
+
 from alfa_bench.analysis import (
     by_fault_latex,
     by_fault_markdown,
@@ -9,6 +11,8 @@ from alfa_bench.analysis import (
     comparison_latex,
     comparison_markdown,
     comparison_table,
+    failures_table,
+    read_failures,
     read_records,
     summary_latex,
     summary_markdown,
@@ -21,9 +25,12 @@ sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 manifest = read_manifest(sm.input.manifest)
 records = read_records(sm.input.detections)
-summary = summary_table(records, manifest, sm.params.subsets)
-by_fault = by_fault_table(records, manifest, sm.params.subsets)
-comparison = comparison_table(records, manifest, sm.params.subsets)
+failures = failures_table(pd.read_csv(sm.input.load_failures, dtype=str, keep_default_na=False),
+                          read_failures(sm.input.detections))
+failures.to_csv(sm.output.failures, index=False)
+summary = summary_table(records, manifest, sm.params.subsets, failures)
+by_fault = by_fault_table(records, manifest, sm.params.subsets, failures)
+comparison = comparison_table(records, manifest, sm.params.subsets, failures)
 summary.to_csv(sm.output.summary, index=False)
 by_fault.to_csv(sm.output.by_fault, index=False)
 comparison.to_csv(sm.output.comparison, index=False)

@@ -19,7 +19,8 @@ def comparison(**overrides):
     row = {"subset": "all", "method": "a", "detector": "d", "calibration": "none",
            "flights": 10, "precision": 0.5, "recall": 0.25, "accuracy": 0.4,
            "mean_detection_s": 1.5, "max_detection_s": float("nan"),
-           "fault_free_flights": 3, "fault_free_false_alarms": 1, "armed_flights": 10}
+           "fault_free_flights": 3, "fault_free_false_alarms": 1, "armed_flights": 10,
+           "excluded": 1}
     rows = [row, {**row, "method": "b", "accuracy": 0.6}]
     return pd.DataFrame([{**r, **overrides} for r in rows])
 
@@ -82,4 +83,5 @@ def test_latex_tables_escape_and_label():
     tex = comparison_latex(comparison())
     assert r"\label{tab:comparison-1}" in tex and r"\texttt{all}" in tex
     assert "\\toprule" in tex and tex.count(r"\begin{table}") == 1
-    assert " & 50.00 & 25.00 & 40.00 & 1.50 & - & 1 of 3 & 10 \\\\" in tex
+    assert " & 50.00 & 25.00 & 40.00 & 1.50 & - & 1 of 3 & 10 & 1 \\\\" in tex
+    assert "(11 flights)" in tex

@@ -2,6 +2,7 @@
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -9,19 +10,25 @@ from pathlib import Path
 import pandas as pd
 import pytest
 import yaml
+from broken import IMU, ROLL, _gap, edit
 from recordings import content
+
+from alfa_bench.methods import make_detector
+from synthetic import write_flight
 
 REPO = Path(__file__).resolve().parent.parent
 SNAKEMAKE = [sys.executable, "-m", "snakemake"]
 
 
-def run_workflow(workdir: Path, alfa_dir: Path) -> None:
+def run_workflow(workdir: Path, alfa_dir: Path, *args: str, target: str = "all",
+                 ok: bool = True) -> subprocess.CompletedProcess:
     env = {**os.environ, "ALFA_DIR": str(alfa_dir)}
-    cmd = [*SNAKEMAKE, "all", "--cores", "2", "--snakefile", str(REPO / "Snakefile"),
+    cmd = [*SNAKEMAKE, target, "--cores", "2", "--snakefile", str(REPO / "Snakefile"),
            "--directory", str(workdir), "--configfile", str(REPO / "config/config.yaml"),
-           "--quiet"]
+           "--quiet", *args]
     done = subprocess.run(cmd, env=env, capture_output=True, text=True)
-    assert done.returncode == 0, done.stdout + done.stderr
+    assert (done.returncode == 0) == ok, done.stdout + done.stderr
+    return done
 
 
 @pytest.fixture(scope="module")
@@ -39,7 +46,9 @@ def test_outputs_and_their_contents(runs, corpus):
     assert set(summary["method"]) == set(config["methods"])
     assert list(summary.columns) == [
         "method", "subset", "flights", "tp", "fp", "fn", "tn", "precision", "recall",
-        "accuracy", "mean_detection_s", "max_detection_s"]
+        "accuracy", "mean_detection_s", "max_detection_s", "excluded"]
+    assert (summary["excluded"] == 0).all()
+    assert pd.read_csv(out / "tables/failures.csv").empty
     assert set(summary["subset"]) == set(config["subsets"])
     by_fault = pd.read_csv(out / "tables/by_fault.csv")
     assert {"engine", "rudder", "aileron", "none", "total"} <= set(by_fault["fault_class"])
@@ -121,3 +130,48 @@ def test_two_runs_are_byte_identical(runs):
             assert content(a / rel) == content(b / rel), rel
         else:
             assert (a / rel).read_bytes() == (b / rel).read_bytes(), rel
+
+
+@pytest.fixture(scope="module")
+def broken_corpus(corpus, tmp_path_factory):
+    """The corpus plus a flight that cannot be read at all and one with a 5 s gap in
+    its IMU topic, which only the methods reading the IMU cannot use."""
+    root = tmp_path_factory.mktemp("broken")
+    shutil.copytree(corpus, root / "processed")
+    unreadable = write_flight(root / "processed", "carbonZ_2018-09-11-14-22-07_2_no_failure",
+                              seed=7)
+    (unreadable / f"{unreadable.name}-{ROLL}.csv").write_text("")
+    gap = write_flight(root / "processed", "carbonZ_2018-10-05-15-55-10_elevator_failure",
+                       onset_s=40.0, fault_topic="failure_status-elevator", seed=8)
+    edit(IMU, _gap)(gap)
+    return root, unreadable.name, gap.name
+
+
+def test_broken_flights_are_excluded_and_reported(broken_corpus, tmp_path):
+    root, unreadable, gap = broken_corpus
+    run_workflow(tmp_path, root, target="results/tables/summary.csv")
+    failures = pd.read_csv(tmp_path / "results/tables/failures.csv", keep_default_na=False)
+    config = yaml.safe_load((REPO / "config/config.yaml").read_text())
+    imu_methods = {m for m, spec in config["methods"].items()
+                   if "roll_rate" in make_detector(spec["detector"], spec.get("params")).signals()}
+    assert imu_methods and imu_methods != set(config["methods"])
+    load = failures[failures["stage"] == "load"]
+    assert load["flight"].tolist() == [unreadable] and "empty file" in load["error"].iloc[0]
+    own = failures[failures["stage"] != "load"]
+    assert set(own["flight"]) == {gap} and set(own["method"]) == imu_methods
+    assert (own["file"] == f"{gap}-{IMU}.csv").all()
+    summary = pd.read_csv(tmp_path / "results/tables/summary.csv").set_index(["method", "subset"])
+    for method in config["methods"]:
+        row = summary.loc[(method, "all")]
+        # the unreadable flight is excluded everywhere, the gap only where the IMU is read
+        assert row["excluded"] == 1 + (method in imu_methods), method
+        assert row["flights"] + row["excluded"] == 8, method
+    assert "| excluded |" in (tmp_path / "results/tables/summary.md").read_text()
+
+
+def test_strict_mode_stops_at_the_first_broken_flight(broken_corpus, tmp_path):
+    root, unreadable, _ = broken_corpus
+    done = run_workflow(tmp_path, root, "--config", "strict=True",
+                        target="results/tables/summary.csv", ok=False)
+    log = (tmp_path / "results/logs/manifest.log").read_text()
+    assert f"flight {unreadable}" in log and "empty file" in log, done.stderr
