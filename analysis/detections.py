@@ -28,7 +28,7 @@ from alfa_bench.methods import (
 )
 
 from .calibration import folds
-from .provenance import provenance
+from .provenance import provenance, read_table
 from .scoring import flight_outcome
 
 __all__ = ["detect_all", "detection_record", "read_failures", "read_records", "write_record"]
@@ -66,7 +66,7 @@ def detect_all(method: str, spec: dict, flights: dict[str, Flight], manifest: pd
 
     def run(name: str, info: dict | None = None):
         return guarded("detect", name, lambda: detection_record(
-            method, spec, detector, flights[name], sha[name], info))
+            method, spec, detector, flights[name], sha, info))
 
     if not detector.calibrated:
         for name in manifest.loc[manifest["ground_truth"], "flight"]:
@@ -86,9 +86,11 @@ def detect_all(method: str, spec: dict, flights: dict[str, Flight], manifest: pd
 
 
 def detection_record(method: str, spec: dict, detector: Detector, flight: Flight,
-                     flight_sha256: str, calibration: dict | None = None
+                     sha256: dict[str, str], calibration: dict | None = None
                      ) -> tuple[dict, Trace]:
-    """Run ``detector`` (fitted if calibrated) on ``flight``: its record and trace."""
+    """Run ``detector`` (fitted if calibrated) on ``flight``: its record and trace.
+    ``sha256`` maps flights to their checksums; the record's provenance gives those of
+    ``flight`` and of the flights that calibrated the detector."""
     if flight.fault is None:
         raise ValueError(f"flight {flight.id} has no ground truth and cannot be scored")
     trace = run_detector(detector, flight, probes=True)
@@ -114,7 +116,10 @@ def detection_record(method: str, spec: dict, detector: Detector, flight: Flight
                  "start_s": float(trace.t[0]), "stop_s": float(trace.t[-1])},
         "repairs": list(flight.repairs),
         "calibration": calibration,
-        "provenance": provenance(spec, {"flight_sha256": flight_sha256}),
+        "provenance": provenance(spec, {
+            "flight_sha256": sha256[flight.id],
+            "calibration_sha256": ({f: sha256[f] for f in calibration["flights"]}
+                                   if calibration else {})}),
     }, trace
 
 
@@ -132,5 +137,5 @@ def read_records(folders) -> list[dict]:
 
 def read_failures(folders) -> list[pd.DataFrame]:
     """The ``failures.csv`` of each ``results/detections/{method}`` folder."""
-    return [pd.read_csv(Path(d) / "failures.csv", dtype=str, keep_default_na=False)
+    return [read_table(Path(d) / "failures.csv", dtype=str, keep_default_na=False)
             for d in folders]

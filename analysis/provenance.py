@@ -1,13 +1,31 @@
-"""What a result was made from: code version, packages, config, inputs."""
+"""What a result was made from: code version, packages, config, inputs, calibration.
+
+Every result file records it (:func:`stamp`, :func:`read_provenance`): the project
+version and git commit, the package versions, the configuration it was made with,
+the SHA-256 of each input flight and the flights that calibrated each fold. The
+record is deterministic (sorted keys, no times), so it does not break byte-identical
+reruns.
+"""
 
 from __future__ import annotations
 
+import json
+import struct
 import subprocess
+import zlib
 from functools import cache
 from importlib import metadata
 from pathlib import Path
 
-__all__ = ["PACKAGES", "code_version", "package_versions", "provenance"]
+import numpy as np
+import pandas as pd
+
+from .calibration import folds
+
+__all__ = ["PACKAGES", "code_version", "package_versions", "provenance", "read_provenance",
+           "read_table", "run_provenance", "stamp"]
+
+_CSV_PREFIX = "# provenance: "
 
 PACKAGES = ("alfa-bench", "numpy", "scipy", "pandas", "filterpy", "control", "scikit-learn",
             "rerun-sdk", "snakemake", "matplotlib")
@@ -41,7 +59,102 @@ def package_versions() -> dict:
     return versions
 
 
-def provenance(config: dict, inputs: dict) -> dict:
+def provenance(config: dict, inputs: dict, calibration: dict | None = None) -> dict:
     """The provenance block stored in every result file."""
     return {"code": code_version(), "packages": package_versions(), "config": config,
-            "inputs": inputs}
+            "inputs": inputs, "calibration": calibration}
+
+
+def run_provenance(config: dict, manifest: pd.DataFrame) -> dict:
+    """The provenance of a file made from every flight of ``manifest``: code, packages,
+    the whole workflow ``config``, each flight's checksum and the calibration folds
+    (which flights calibrated the methods scoring each group)."""
+    cal = config.get("calibration")
+    try:
+        folds_ = {g: training for g, (_, training) in folds(manifest, cal["group_by"]).items()}
+    except (TypeError, ValueError):     # no calibration configured, or under two groups
+        folds_ = None
+    return provenance(config, {"flight_sha256": dict(zip(manifest["flight"], manifest["sha256"],
+                                                         strict=True))},
+                      calibration={**(cal or {}), "training_flights": folds_})
+
+
+def _json(prov: dict) -> str:
+    return json.dumps(prov, sort_keys=True, separators=(",", ":"), allow_nan=False)
+
+
+def _png_text(data: bytes, key: str, text: str) -> bytes:
+    """``data`` with a tEXt chunk ``key`` inserted after the IHDR chunk."""
+    body = key.encode("latin-1") + b"\0" + text.encode("latin-1", "backslashreplace")
+    chunk = (struct.pack(">I", len(body)) + b"tEXt" + body
+             + struct.pack(">I", zlib.crc32(b"tEXt" + body)))
+    end_of_ihdr = 8 + 8 + 13 + 4
+    return data[:end_of_ihdr] + chunk + data[end_of_ihdr:]
+
+
+def stamp(path: str | Path, prov: dict) -> None:
+    """Record ``prov`` in the result file ``path``, in the way its format allows:
+    a first ``# provenance: {json}`` line (.csv), a ``%`` line (.tex), an HTML
+    comment (.md), a tEXt chunk (.png), a ``provenance.json`` member (.npz), a
+    ``provenance`` key (.json). Rerun recordings carry it as a recording property
+    (see :mod:`.rerun_log`), traces theirs as an array (see :mod:`.traces`)."""
+    path = Path(path)
+    text = _json(prov)
+    match path.suffix:
+        case ".csv":
+            path.write_text(f"{_CSV_PREFIX}{text}\n" + path.read_text())
+        case ".tex":
+            path.write_text(f"% provenance: {text}\n" + path.read_text())
+        case ".md":
+            path.write_text(path.read_text() + f"\n<!-- provenance: {text} -->\n")
+        case ".png":
+            path.write_bytes(_png_text(path.read_bytes(), "provenance", text))
+        case ".json":
+            record = json.loads(path.read_text())
+            path.write_text(json.dumps({**record, "provenance": prov}, sort_keys=True,
+                                       indent=1, allow_nan=False) + "\n")
+        case _:
+            raise ValueError(f"cannot record provenance in {path}")
+
+
+def read_provenance(path: str | Path) -> dict:
+    """The provenance recorded in a result file (see :func:`stamp`)."""
+    path = Path(path)
+    match path.suffix:
+        case ".csv" | ".tex":
+            first = path.read_text().split("\n", 1)[0]
+            return json.loads(first.split("provenance: ", 1)[1])
+        case ".md":
+            last = path.read_text().rstrip().rsplit("\n", 1)[-1]
+            return json.loads(last.removeprefix("<!-- provenance: ").removesuffix(" -->"))
+        case ".png":
+            return json.loads(_png_chunks(path.read_bytes())[b"provenance"])
+        case ".npz":
+            with np.load(path) as z:
+                return json.loads(str(z["provenance"][0]))
+        case ".json":
+            return json.loads(path.read_text())["provenance"]
+        case ".rrd":
+            from .rerun_log import read_rerun_provenance
+            return read_rerun_provenance(path)
+    raise ValueError(f"no provenance is recorded in {path}")
+
+
+def _png_chunks(data: bytes) -> dict[bytes, str]:
+    out, pos = {}, 8
+    while pos < len(data):
+        (n,) = struct.unpack_from(">I", data, pos)
+        kind = data[pos + 4:pos + 8]
+        if kind == b"tEXt":
+            key, _, value = data[pos + 8:pos + 8 + n].partition(b"\0")
+            out[key] = value.decode("latin-1")
+        pos += 12 + n
+    return out
+
+
+def read_table(path: str | Path, **kwargs) -> pd.DataFrame:
+    """A result CSV, without its provenance line (``kwargs`` go to pandas)."""
+    path = Path(path)
+    with path.open() as f:
+        skip = 1 if f.readline().startswith(_CSV_PREFIX) else 0
+    return pd.read_csv(path, skiprows=skip, **kwargs)

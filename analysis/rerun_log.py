@@ -19,17 +19,20 @@ Entities
     :math:`\\max_c s_c/\\gamma_c`: above 1 the method alarms.
 ``events``
     Fault onset and end, and the start of every alarm of every method.
-Recording property ``flight``: fault class, onset, end, date, label and the code
-version that wrote the file.
+Recording properties: ``flight`` (fault class, onset, end, date, label and the
+code version that wrote the file) and ``provenance`` (the run's provenance as JSON,
+:func:`read_rerun_provenance`).
 """
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
+import rerun.chunk as rc
 
 from alfa_bench.data import SIGNALS, Flight, series
 from alfa_bench.methods import Trace
@@ -37,7 +40,7 @@ from alfa_bench.methods import Trace
 from .provenance import code_version
 from .sweep import ratio
 
-__all__ = ["TIMELINE", "blueprint", "signal_group", "write_rerun_log"]
+__all__ = ["TIMELINE", "blueprint", "read_rerun_provenance", "signal_group", "write_rerun_log"]
 
 TIMELINE = "flight_time"
 _APPLICATION = "alfa-bench"
@@ -99,9 +102,9 @@ def _events(flight: Flight, traces: dict[str, Trace]) -> list[tuple[float, str, 
 
 
 def write_rerun_log(flight: Flight, traces: dict[str, Trace], signals: list[str],
-                    path: str | Path) -> None:
+                    path: str | Path, provenance: dict) -> None:
     """Write the recording of ``flight`` with the ``traces`` of each method (with
-    probes) and the raw ``signals`` to ``path``."""
+    probes), the raw ``signals`` and the run's ``provenance`` to ``path``."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     groups = [g for g in _GROUPS if any(signal_group(s) == g for s in signals)]
@@ -115,6 +118,8 @@ def write_rerun_log(flight: Flight, traces: dict[str, Trace], signals: list[str]
         onset_s=np.nan if fault is None or fault.onset_s is None else fault.onset_s,
         fault_end_s=np.nan if fault is None or fault.end_s is None else fault.end_s,
         git_commit=code_version()["git_commit"] or "unknown"))
+    rec.send_property("provenance", rr.AnyValues(
+        json=json.dumps(provenance, sort_keys=True, allow_nan=False)))
 
     for s in signals:
         t, v = series(flight, s)
@@ -139,3 +144,11 @@ def write_rerun_log(flight: Flight, traces: dict[str, Trace], signals: list[str]
                          columns=rr.TextLog.columns(text=list(texts), level=list(levels)))
     rec.flush()
     rec.disconnect()
+
+
+def read_rerun_provenance(path: str | Path) -> dict:
+    """The provenance a recording written by :func:`write_rerun_log` carries."""
+    for chunk in rc.RrdReader(path).store().stream().to_chunks():
+        if chunk.entity_path == "/__properties/provenance":
+            return json.loads(chunk.to_record_batch().column("json").to_pylist()[0][0])
+    raise ValueError(f"{path} carries no provenance property")

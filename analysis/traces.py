@@ -1,7 +1,8 @@
 """Stored detector traces: what the sweeps, figures and rerun logs read back.
 
 ``results/traces/{method}/{flight}.npz`` holds a run's grid times, scores, channel
-thresholds and probes. Alarms are not stored: by the detector contract a channel
+thresholds and probes, and its provenance (a JSON string, ``provenance``). Alarms
+are not stored: by the detector contract a channel
 alarms exactly when its score exceeds its threshold. The archive is written with
 fixed member dates, so the same trace gives the same bytes.
 """
@@ -9,6 +10,7 @@ fixed member dates, so the same trace gives the same bytes.
 from __future__ import annotations
 
 import io
+import json
 import zipfile
 from pathlib import Path
 
@@ -21,8 +23,9 @@ __all__ = ["read_trace", "read_traces", "write_trace"]
 _EPOCH = (1980, 1, 1, 0, 0, 0)  # the earliest date a zip member can carry
 
 
-def write_trace(trace: Trace, path: str | Path) -> None:
-    """Write ``trace`` to ``path`` (an ``.npz`` that :func:`numpy.load` reads)."""
+def write_trace(trace: Trace, path: str | Path, provenance: dict) -> None:
+    """Write ``trace`` and its ``provenance`` to ``path`` (an ``.npz`` that
+    :func:`numpy.load` reads)."""
     names = list(trace.probes)
     arrays = {
         "t": trace.t,
@@ -32,6 +35,7 @@ def write_trace(trace: Trace, path: str | Path) -> None:
         "probe_names": np.array(names, dtype=str),
         "probes": (np.column_stack([trace.probes[n] for n in names]) if names
                    else np.empty((trace.t.size, 0))),
+        "provenance": np.array([json.dumps(provenance, sort_keys=True, allow_nan=False)]),
     }
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)

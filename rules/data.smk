@@ -13,12 +13,11 @@ if DOWNLOAD:
 
 rule manifest:
     input:
-        PROCESSED,
+        processed=PROCESSED,
     output:
         manifest="data/flights.csv",
         failures="data/load_failures.csv",
     params:
-        processed=str(PROCESSED),
         strict=config["strict"],
     log:
         "results/logs/manifest.log",

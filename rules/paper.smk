@@ -15,6 +15,7 @@ PAPER_DIR = Path(workflow.basedir) / "paper"
 rule paper_sources:
     input:
         PAPER_INPUTS,
+        manifest="data/flights.csv",
         comparison="results/tables/comparison.csv",
         sweep="results/tables/sweep.csv",
         tex=PAPER_DIR / "paper.tex",

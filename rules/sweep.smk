@@ -35,6 +35,7 @@ rule figures:
 # apart from the other figures, so that the two draw in parallel
 rule flight_figures:
     input:
+        manifest="data/flights.csv",
         detections=expand("results/detections/{method}", method=METHODS),
         traces=expand("results/traces/{method}", method=METHODS),
     output:

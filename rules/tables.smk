@@ -24,6 +24,7 @@ rule tables:
 
 rule runtime:
     input:
+        manifest="data/flights.csv",
         detections=expand("results/detections/{method}", method=METHODS),
         benchmarks=expand("results/benchmarks/detect/{method}.tsv", method=METHODS),
     output:

@@ -9,6 +9,7 @@ import pandas as pd
 
 from alfa_bench.analysis import detect_all, write_record
 from alfa_bench.analysis.logs import log_to
+from alfa_bench.analysis.provenance import run_provenance, stamp
 from alfa_bench.analysis.traces import write_trace
 from alfa_bench.data import FAILURE_COLUMNS, load_flight, read_manifest
 
@@ -24,7 +25,8 @@ failures = None if sm.params.strict else []
 for record, trace in detect_all(sm.wildcards.method, json.loads(sm.params.spec), flights, manifest,
                                 dict(sm.params.calibration), failures):
     write_record(record, out / f"{record['flight']}.json")
-    write_trace(trace, traces / f"{record['flight']}.npz")
+    write_trace(trace, traces / f"{record['flight']}.npz", record["provenance"])
     logging.info("%s: %s, first alarm %s", record["flight"], record["outcome"],
                  record["first_alarm_s"])
 pd.DataFrame(failures or [], columns=FAILURE_COLUMNS).to_csv(out / "failures.csv", index=False)
+stamp(out / "failures.csv", run_provenance(sm.config, manifest))

@@ -5,12 +5,15 @@ from pathlib import Path
 from alfa_bench.analysis import read_records
 from alfa_bench.analysis.figures import flight_figure
 from alfa_bench.analysis.logs import log_to
+from alfa_bench.analysis.provenance import run_provenance, stamp
 from alfa_bench.analysis.traces import read_traces
+from alfa_bench.data import read_manifest
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 records = read_records(sm.input.detections)
 traces = read_traces(sm.input.traces)
+prov = run_provenance(sm.config, read_manifest(sm.input.manifest))
 methods = list(dict.fromkeys(r["method"] for r in records))
 # a flight a method excluded is drawn without it
 for rec in {r["flight"]: r for r in records}.values():
@@ -18,3 +21,4 @@ for rec in {r["flight"]: r for r in records}.values():
     flight_figure(flight, rec["onset_s"], rec["fault_end_s"],
                   {m: traces[m, flight] for m in methods if (m, flight) in traces},
                   Path(sm.output[0]) / f"{flight}.png")
+    stamp(Path(sm.output[0]) / f"{flight}.png", prov)

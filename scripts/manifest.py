@@ -9,9 +9,9 @@ from alfa_bench.data import FAILURE_COLUMNS, build_manifest, scan_flights
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 if sm.params.strict:
-    manifest = build_manifest(sm.params.processed)
+    manifest = build_manifest(sm.input.processed)
     failures = pd.DataFrame(columns=[*FAILURE_COLUMNS, "subsets"])
 else:
-    manifest, failures = scan_flights(sm.params.processed)
+    manifest, failures = scan_flights(sm.input.processed)
 manifest.to_csv(sm.output.manifest, index=False)
 failures.to_csv(sm.output.failures, index=False)

@@ -5,6 +5,7 @@ import logging
 from pathlib import Path
 
 from alfa_bench.analysis.logs import log_to
+from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.analysis.rerun_log import write_rerun_log
 from alfa_bench.analysis.traces import read_traces
 from alfa_bench.data import load_flight, read_manifest
@@ -18,8 +19,11 @@ order = [Path(d).name for d in sm.input.traces]
 detectors = [make_detector(spec["detector"], spec.get("params")) for spec in specs.values()]
 signals = list(dict.fromkeys(s for d in detectors for s in d.signals()))
 traces = read_traces(sm.input.traces)
+prov = run_provenance(sm.config, manifest)
 out = Path(sm.output[0])
 for flight in manifest.loc[manifest["ground_truth"], "flight"]:
-    write_rerun_log(load_flight(Path(sm.params.processed) / flight),
-                    {m: traces[m, flight] for m in order if (m, flight) in traces}, signals, out / f"{flight}.rrd")
+    # a flight a method excluded is recorded without it
+    mine = {m: traces[m, flight] for m in order if (m, flight) in traces}
+    write_rerun_log(load_flight(Path(sm.params.processed) / flight), mine, signals,
+                    out / f"{flight}.rrd", prov)
     logging.info("%s: written", flight)

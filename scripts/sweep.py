@@ -2,12 +2,15 @@
 
 from alfa_bench.analysis import read_records
 from alfa_bench.analysis.logs import log_to
+from alfa_bench.analysis.provenance import run_provenance, stamp
 from alfa_bench.analysis.sweep import sweep_table
 from alfa_bench.analysis.traces import read_traces
 from alfa_bench.data import read_manifest
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
-sweep = sweep_table(read_records(sm.input.detections), read_traces(sm.input.traces),
-                    read_manifest(sm.input.manifest), sm.params.subsets)
+manifest = read_manifest(sm.input.manifest)
+sweep = sweep_table(read_records(sm.input.detections), read_traces(sm.input.traces), manifest,
+                    sm.params.subsets)
 sweep.to_csv(sm.output[0], index=False)
+stamp(sm.output[0], run_provenance(sm.config, manifest))

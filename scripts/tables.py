@@ -19,6 +19,7 @@ from alfa_bench.analysis import (
     summary_table,
 )
 from alfa_bench.analysis.logs import log_to
+from alfa_bench.analysis.provenance import run_provenance, stamp
 from alfa_bench.data import read_manifest
 
 sm = snakemake  # noqa: F821
@@ -40,3 +41,6 @@ Path(sm.output.comparison_md).write_text(comparison_markdown(comparison))
 Path(sm.output.summary_tex).write_text(summary_latex(summary))
 Path(sm.output.by_fault_tex).write_text(by_fault_latex(by_fault))
 Path(sm.output.comparison_tex).write_text(comparison_latex(comparison))
+prov = run_provenance(sm.config, manifest)
+for path in sm.output:
+    stamp(path, prov)

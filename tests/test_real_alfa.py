@@ -45,7 +45,7 @@ def test_a_real_flight_gives_a_complete_record(manifest, real_processed):
     record, trace = detection_record("rls_arx_zscore", {"detector": "rls_arx_zscore"},
                                      make_detector("rls_arx_zscore"),
                                      load_flight(real_processed / row["flight"]),
-                                     row["sha256"])
+                                     {row["flight"]: row["sha256"]})
     assert record["first_alarm_s"] == trace.first_alarm_s()
     assert record["outcome"] in {"TP", "FP", "FN", "TN", "FP+FN"}
     assert record["grid"]["samples"] > 25 * 60

@@ -5,7 +5,7 @@ import pytest
 import rerun.chunk as rc
 from recordings import content
 
-from alfa_bench.analysis.rerun_log import write_rerun_log
+from alfa_bench.analysis.rerun_log import read_rerun_provenance, write_rerun_log
 from alfa_bench.data import load_flight, series
 from alfa_bench.methods import make_detector, run_detector
 
@@ -20,7 +20,7 @@ def recording(tmp_path_factory, corpus):
     traces = {"rls": run_detector(detector, flight, probes=True)}
     paths = [tmp_path_factory.mktemp("rrd") / f"{flight.id}.rrd" for _ in range(2)]
     for path in paths:
-        write_rerun_log(flight, traces, SIGNALS, path)
+        write_rerun_log(flight, traces, SIGNALS, path, {"inputs": {"a": "0" * 64}})
     return flight, traces["rls"], paths
 
 
@@ -62,3 +62,8 @@ def test_the_fault_and_flight_are_recording_properties(recording):
 def test_the_same_run_writes_the_same_content(recording):
     _, _, (a, b) = recording
     assert content(a) == content(b)
+
+
+def test_the_recording_carries_its_provenance(recording):
+    _, _, (path, _) = recording
+    assert read_rerun_provenance(path) == {"inputs": {"a": "0" * 64}}

@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from alfa_bench.analysis.provenance import read_provenance
 from alfa_bench.analysis.traces import read_trace, read_traces, write_trace
 from alfa_bench.data import load_flight
 from alfa_bench.methods import make_detector, run_detector
@@ -11,8 +12,9 @@ def test_round_trip_keeps_every_value_and_rebuilds_alarms(one_flight, tmp_path):
     trace = run_detector(make_detector("rls_arx_zscore"), load_flight(one_flight),
                          probes=True)
     path = tmp_path / "rls" / "f.npz"
-    write_trace(trace, path)
+    write_trace(trace, path, {"config": {"a": 1}})
     back = read_trace(path)
+    assert read_provenance(path) == {"config": {"a": 1}}
     np.testing.assert_array_equal(back.t, trace.t)
     np.testing.assert_array_equal(back.score, trace.score)
     np.testing.assert_array_equal(back.alarm, trace.alarm)
@@ -26,7 +28,7 @@ def test_round_trip_keeps_every_value_and_rebuilds_alarms(one_flight, tmp_path):
 
 def test_the_same_trace_gives_the_same_bytes(one_flight, tmp_path):
     trace = run_detector(make_detector("rls_arx_zscore"), load_flight(one_flight))
-    write_trace(trace, tmp_path / "a.npz")
-    write_trace(trace, tmp_path / "b.npz")
+    write_trace(trace, tmp_path / "a.npz", {})
+    write_trace(trace, tmp_path / "b.npz", {})
     assert (tmp_path / "a.npz").read_bytes() == (tmp_path / "b.npz").read_bytes()
     assert read_trace(tmp_path / "a.npz").probes == {}

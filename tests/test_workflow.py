@@ -7,12 +7,12 @@ import subprocess
 import sys
 from pathlib import Path
 
-import pandas as pd
 import pytest
 import yaml
 from broken import IMU, ROLL, _gap, edit
 from recordings import content
 
+from alfa_bench.analysis.provenance import read_provenance, read_table
 from alfa_bench.methods import make_detector
 from synthetic import write_flight
 
@@ -42,15 +42,15 @@ def runs(corpus, tmp_path_factory):
 def test_outputs_and_their_contents(runs, corpus):
     out = runs[0] / "results"
     config = yaml.safe_load((REPO / "config/config.yaml").read_text())
-    summary = pd.read_csv(out / "tables/summary.csv")
+    summary = read_table(out / "tables/summary.csv")
     assert set(summary["method"]) == set(config["methods"])
     assert list(summary.columns) == [
         "method", "subset", "flights", "tp", "fp", "fn", "tn", "precision", "recall",
         "accuracy", "mean_detection_s", "max_detection_s", "excluded"]
     assert (summary["excluded"] == 0).all()
-    assert pd.read_csv(out / "tables/failures.csv").empty
+    assert read_table(out / "tables/failures.csv").empty
     assert set(summary["subset"]) == set(config["subsets"])
-    by_fault = pd.read_csv(out / "tables/by_fault.csv")
+    by_fault = read_table(out / "tables/by_fault.csv")
     assert {"engine", "rudder", "aileron", "none", "total"} <= set(by_fault["fault_class"])
     for method in config["methods"]:
         records = sorted((out / "detections" / method).glob("*.json"))
@@ -60,7 +60,7 @@ def test_outputs_and_their_contents(runs, corpus):
                 "pair_first_alarm_s", "pair_armed_s", "outcome", "provenance"} <= set(r)
         assert r["provenance"]["inputs"]["flight_sha256"]
     assert "Keipour et al. ICRA 2019 (paper)" in (out / "tables/summary.md").read_text()
-    comparison = pd.read_csv(out / "tables/comparison.csv")
+    comparison = read_table(out / "tables/comparison.csv")
     assert set(comparison["method"]) == set(config["methods"])
     calibrated = comparison[comparison["calibration"] != "none"]
     assert set(calibrated["detector"]) == {"glrt_residuals", "ffrls_monitor", "kalman_okid"}
@@ -76,10 +76,10 @@ def test_inspection_outputs_sweeps_figures_and_paper(runs, corpus):
     assert sorted(p.stem for p in (out / "rerun").glob("*.rrd")) == flights
     for method in config["methods"]:
         assert sorted(p.stem for p in (out / "traces" / method).glob("*.npz")) == flights
-    sweep = pd.read_csv(out / "tables/sweep.csv")
+    sweep = read_table(out / "tables/sweep.csv")
     assert set(sweep["method"]) == set(config["methods"])
     assert (sweep["scale"] == 1.0).any()
-    summary = pd.read_csv(out / "tables/summary.csv").set_index(["method", "subset"])
+    summary = read_table(out / "tables/summary.csv").set_index(["method", "subset"])
     at_one = sweep[sweep["scale"] == 1.0].set_index(["method", "subset"])
     for col in ("tp", "fp", "fn", "tn"):  # the sweep at scale 1 is the configured run
         assert (at_one[col] == summary.loc[at_one.index, col]).all(), col
@@ -109,15 +109,40 @@ def test_the_html_report_holds_the_figures_and_tables(runs, corpus):
 
 def test_synthetic_faults_are_found(runs):
     """The synthetic faults are gross: every one is found within a second of onset."""
-    summary = pd.read_csv(runs[0] / "results/tables/summary.csv").set_index(["method", "subset"])
+    summary = read_table(runs[0] / "results/tables/summary.csv").set_index(["method", "subset"])
     row = summary.loc[("rls_arx_zscore_fresh", "all")]
     assert (row["flights"], row["tp"], row["fn"]) == (6, 4, 0)
     assert row["max_detection_s"] < 1.0
 
 
+def test_every_result_file_records_its_provenance(runs, corpus):
+    work = runs[0]
+    files = [p for p in (work / "results").rglob("*") if p.is_file()
+             and not p.name.startswith(".snakemake")     # Snakemake's directory markers
+             and not {"logs", "benchmarks"} & set(p.relative_to(work).parts)]
+    files += [work / "paper/build/paper.md", work / "paper/build/results.tex"]
+    assert {p.suffix for p in files} == {".csv", ".md", ".tex", ".json", ".npz", ".png", ".rrd"}
+    flights = {p.name for p in corpus.iterdir()}
+    for path in files:
+        prov = read_provenance(path)
+        assert prov["code"]["version"] and "git_commit" in prov["code"], path
+        assert prov["packages"]["numpy"] and prov["config"], path
+        inputs = prov["inputs"]
+        if path.suffix in (".json", ".npz"):       # one flight's run, and its calibration
+            assert len(inputs["flight_sha256"]) == 64, path
+            checksums = inputs["calibration_sha256"]
+        else:                                    # every flight, and the calibration folds
+            checksums = inputs["flight_sha256"]
+            assert set(checksums) == flights, path
+            assert set(prov["calibration"]["training_flights"]) == {
+                "2018-07-18", "2018-07-30", "2018-09-11", "2018-10-05"}, path
+        assert all(len(v) == 64 for v in checksums.values()), path
+
+
 def test_two_runs_are_byte_identical(runs):
-    """Every result is byte-identical between runs, but the rerun recordings, whose row
-    ids rerun draws from the clock: their entities, times and values are identical."""
+    """Every result is byte-identical between runs, but the rerun recordings: rerun 0.41
+    draws its ids from the clock and orders its footer index by a hash map (README,
+    "Inspecting a run"), so their entities, times and values are compared."""
     a, b = runs
     skip = {"logs", "benchmarks", "runtime"}                 # times vary between runs
     files = sorted(p.relative_to(a) for p in (a / "results").rglob("*")
@@ -150,7 +175,7 @@ def broken_corpus(corpus, tmp_path_factory):
 def test_broken_flights_are_excluded_and_reported(broken_corpus, tmp_path):
     root, unreadable, gap = broken_corpus
     run_workflow(tmp_path, root, target="results/tables/summary.csv")
-    failures = pd.read_csv(tmp_path / "results/tables/failures.csv", keep_default_na=False)
+    failures = read_table(tmp_path / "results/tables/failures.csv", keep_default_na=False)
     config = yaml.safe_load((REPO / "config/config.yaml").read_text())
     imu_methods = {m for m, spec in config["methods"].items()
                    if "roll_rate" in make_detector(spec["detector"], spec.get("params")).signals()}
@@ -160,7 +185,7 @@ def test_broken_flights_are_excluded_and_reported(broken_corpus, tmp_path):
     own = failures[failures["stage"] != "load"]
     assert set(own["flight"]) == {gap} and set(own["method"]) == imu_methods
     assert (own["file"] == f"{gap}-{IMU}.csv").all()
-    summary = pd.read_csv(tmp_path / "results/tables/summary.csv").set_index(["method", "subset"])
+    summary = read_table(tmp_path / "results/tables/summary.csv").set_index(["method", "subset"])
     for method in config["methods"]:
         row = summary.loc[(method, "all")]
         # the unreadable flight is excluded everywhere, the gap only where the IMU is read
@@ -175,3 +200,25 @@ def test_strict_mode_stops_at_the_first_broken_flight(broken_corpus, tmp_path):
                         target="results/tables/summary.csv", ok=False)
     log = (tmp_path / "results/logs/manifest.log").read_text()
     assert f"flight {unreadable}" in log and "empty file" in log, done.stderr
+
+
+@pytest.mark.parametrize("config, message", [
+    ("calibration: {group_by: week, margin_s: 1.0}", "'week' is not one of ['date', 'flight']"),
+    ("strict: maybe", "'maybe' is not of type 'boolean'"),
+    ("methods: {x: {detector: rls_arx_zscor}}", "config methods.x: \"unknown detector"),
+    ("methods: {x: {detector: rls_arx_zscore, params: {zthreshold: 3}}}",
+     "config methods.x: detector 'rls_arx_zscore' has no parameter 'zthreshold'"),
+])
+def test_a_wrong_config_value_is_named_before_any_job_runs(corpus, tmp_path, config, message):
+    (tmp_path / "bad.yaml").write_text(config + "\n")
+    done = run_workflow(tmp_path, corpus.parent, "-n", "--configfile",
+                        str(REPO / "config/config.yaml"), str(tmp_path / "bad.yaml"), ok=False)
+    assert message in done.stderr + done.stdout
+
+
+def test_lint_asks_only_for_per_rule_software_environments(corpus, tmp_path):
+    """Packages are pinned by constraints.txt and installed by the README's command, so
+    the per-rule conda/container lint is the one accepted; any other lint fails here."""
+    done = run_workflow(tmp_path, corpus.parent, "--lint", ok=False)
+    titles = {line.strip() for line in done.stderr.splitlines() if line.startswith("    * ")}
+    assert titles == {"* Specify a conda environment or container for each rule.:"}
