@@ -18,6 +18,7 @@ include: "rules/tables.smk"
 include: "rules/sweep.smk"
 include: "rules/rerun.smk"
 include: "rules/paper.smk"
+include: "rules/inject.smk"
 
 
 rule all:
@@ -30,5 +31,7 @@ rule all:
         rules.readme_figure.output,
         rules.rerun_logs.output,
         rules.paper_sources.output,
+        rules.detectability.output,
+        rules.isolation.output,
         # the PDF where a LaTeX engine (latexmk + pdflatex) is installed
         rules.paper_pdf.output if LATEX else [],

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from alfa_bench.data import AlfaDataError, Flight, failure_row
+from alfa_bench.data import FAILURE_COLUMNS, AlfaDataError, Flight, failure_row
 from alfa_bench.methods import (
     Detector,
     Trace,
@@ -27,28 +27,38 @@ from alfa_bench.methods import (
     run_detector,
 )
 
-from .calibration import folds
-from .provenance import provenance, read_table
+from .calibration import GROUPINGS, folds
+from .provenance import provenance, read_table, run_provenance, stamp
 from .scoring import flight_outcome
+from .traces import write_trace
 
-__all__ = ["detect_all", "detection_record", "read_failures", "read_records", "write_record"]
+__all__ = ["detect_all", "detection_record", "read_failures", "read_records", "write_detections",
+           "write_record"]
 
 log = logging.getLogger(__name__)
 
 
 def detect_all(method: str, spec: dict, flights: dict[str, Flight], manifest: pd.DataFrame,
-               calibration: dict, failures: list[dict] | None = None
+               calibration: dict, failures: list[dict] | None = None,
+               calibrate_on: pd.DataFrame | None = None, probes: bool = True
                ) -> Iterator[tuple[dict, Trace]]:
     """Records and traces (with probes) of ``spec`` (``{"detector": name, "params":
     {...}}``) on every flight of ``manifest`` with ground truth; ``calibration`` is
     ``{"group_by", "margin_s"}``.
+
+    A calibrated method is fitted per fold on the other groups' flights of
+    ``calibrate_on`` (default ``manifest``): injected flights are scored by the
+    model of their source's group, fitted on real flights only. ``probes`` keeps the
+    intermediates in the traces.
 
     With ``failures`` None, a flight that cannot be read raises its
     :class:`~alfa_bench.data.AlfaDataError`; with a list, the flight is skipped and a
     :func:`~alfa_bench.data.failure_row` appended, once per flight.
     """
     detector = make_detector(spec["detector"], spec.get("params"))
+    train = manifest if calibrate_on is None else calibrate_on
     sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
+    sha |= dict(zip(train["flight"], train["sha256"], strict=True))
     failed: set[str] = set()
 
     def guarded(stage: str, name: str, fn):
@@ -66,14 +76,20 @@ def detect_all(method: str, spec: dict, flights: dict[str, Flight], manifest: pd
 
     def run(name: str, info: dict | None = None):
         return guarded("detect", name, lambda: detection_record(
-            method, spec, detector, flights[name], sha, info))
+            method, spec, detector, flights[name], sha, info, probes))
 
     if not detector.calibrated:
         for name in manifest.loc[manifest["ground_truth"], "flight"]:
             if (out := run(name)) is not None:
                 yield out
         return
-    for fold, (scored, training) in folds(manifest, calibration["group_by"]).items():
+    groups = manifest.loc[manifest["ground_truth"]]
+    groups = groups.groupby(groups[GROUPINGS[calibration["group_by"]]].astype(str))["flight"]
+    scored_by_fold = {g: list(f) for g, f in groups}
+    for fold, (_, training) in folds(train, calibration["group_by"]).items():
+        scored = scored_by_fold.pop(fold, [])
+        if not scored:
+            continue
         segments = {f: guarded("calibration", f, lambda f=f: fault_free_segments(
             detector, [flights[f]], calibration["margin_s"])) for f in training}
         used = [f for f in training if segments[f] is not None]
@@ -83,17 +99,19 @@ def detect_all(method: str, spec: dict, flights: dict[str, Flight], manifest: pd
         for name in scored:
             if (out := run(name, info)) is not None:
                 yield out
+    if scored_by_fold:
+        raise ValueError(f"no calibration flights outside group(s) {sorted(scored_by_fold)}")
 
 
 def detection_record(method: str, spec: dict, detector: Detector, flight: Flight,
-                     sha256: dict[str, str], calibration: dict | None = None
-                     ) -> tuple[dict, Trace]:
+                     sha256: dict[str, str], calibration: dict | None = None,
+                     probes: bool = True) -> tuple[dict, Trace]:
     """Run ``detector`` (fitted if calibrated) on ``flight``: its record and trace.
     ``sha256`` maps flights to their checksums; the record's provenance gives those of
     ``flight`` and of the flights that calibrated the detector."""
     if flight.fault is None:
         raise ValueError(f"flight {flight.id} has no ground truth and cannot be scored")
-    trace = run_detector(detector, flight, probes=True)
+    trace = run_detector(detector, flight, probes=probes)
     onset = flight.fault.onset_s
     first = trace.first_alarm_s()
     outcome = flight_outcome(onset, first)
@@ -103,6 +121,7 @@ def detection_record(method: str, spec: dict, detector: Detector, flight: Flight
         "detector": spec["detector"],
         "parameters": detector.get_params(),
         "fault_class": flight.fault.fault_class,
+        "fault_sensor": flight.fault.sensor,
         "onset_s": onset,
         "fault_end_s": flight.fault.end_s,
         "first_alarm_s": first,
@@ -112,6 +131,7 @@ def detection_record(method: str, spec: dict, detector: Detector, flight: Flight
         "pair_first_alarm_s": {ch: trace.first_alarm_s(i)
                                for i, ch in enumerate(trace.channels)},
         "pair_armed_s": {ch: trace.armed_s(i) for i, ch in enumerate(trace.channels)},
+        "channel_outputs": dict(zip(trace.channels, detector.channel_outputs(), strict=True)),
         "grid": {"rate_hz": detector.rate_hz, "samples": int(trace.t.size),
                  "start_s": float(trace.t[0]), "stop_s": float(trace.t[-1])},
         "repairs": list(flight.repairs),
@@ -139,3 +159,23 @@ def read_failures(folders) -> list[pd.DataFrame]:
     """The ``failures.csv`` of each ``results/detections/{method}`` folder."""
     return [read_table(Path(d) / "failures.csv", dtype=str, keep_default_na=False)
             for d in folders]
+
+
+def write_detections(method: str, spec: dict, flights: dict[str, Flight], manifest: pd.DataFrame,
+                     calibration: dict, *, strict: bool, config: dict, out: Path, traces: Path,
+                     calibrate_on: pd.DataFrame | None = None, probes: bool = True) -> None:
+    """Run :func:`detect_all` and write ``out/<flight>.json``, ``traces/<flight>.npz``
+    and ``out/failures.csv`` (the flights excluded, empty when ``strict``, which
+    raises instead), each with its provenance."""
+    out.mkdir(parents=True, exist_ok=True)
+    traces.mkdir(parents=True, exist_ok=True)
+    failures = None if strict else []
+    for record, trace in detect_all(method, spec, flights, manifest, calibration, failures,
+                                    calibrate_on, probes):
+        write_record(record, out / f"{record['flight']}.json")
+        write_trace(trace, traces / f"{record['flight']}.npz", record["provenance"])
+        log.info("%s %s: %s, first alarm %s", method, record["flight"], record["outcome"],
+                 record["first_alarm_s"])
+    pd.DataFrame(failures or [], columns=FAILURE_COLUMNS).to_csv(out / "failures.csv",
+                                                                  index=False)
+    stamp(out / "failures.csv", run_provenance(config, manifest, calibrate_on))

@@ -65,17 +65,20 @@ def provenance(config: dict, inputs: dict, calibration: dict | None = None) -> d
             "inputs": inputs, "calibration": calibration}
 
 
-def run_provenance(config: dict, manifest: pd.DataFrame) -> dict:
+def run_provenance(config: dict, manifest: pd.DataFrame,
+                   calibrate_on: pd.DataFrame | None = None) -> dict:
     """The provenance of a file made from every flight of ``manifest``: code, packages,
     the whole workflow ``config``, each flight's checksum and the calibration folds
-    (which flights calibrated the methods scoring each group)."""
+    (which flights, of ``calibrate_on`` if given, calibrated each group's methods)."""
     cal = config.get("calibration")
+    train = manifest if calibrate_on is None else calibrate_on
+    sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
+    sha |= dict(zip(train["flight"], train["sha256"], strict=True))
     try:
-        folds_ = {g: training for g, (_, training) in folds(manifest, cal["group_by"]).items()}
+        folds_ = {g: training for g, (_, training) in folds(train, cal["group_by"]).items()}
     except (TypeError, ValueError):     # no calibration configured, or under two groups
         folds_ = None
-    return provenance(config, {"flight_sha256": dict(zip(manifest["flight"], manifest["sha256"],
-                                                         strict=True))},
+    return provenance(config, {"flight_sha256": sha},
                       calibration={**(cal or {}), "training_flights": folds_})
 
 

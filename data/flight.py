@@ -56,7 +56,7 @@ __all__ = [
 
 log = logging.getLogger("alfa_bench.data")
 
-FAULT_CLASSES = ("engine", "rudder", "elevator", "aileron", "rudder+aileron", "none")
+FAULT_CLASSES = ("engine", "rudder", "elevator", "aileron", "rudder+aileron", "sensor", "none")
 
 #: ground-truth topic -> fault class, in the order used to name combined faults
 _GROUND_TRUTH_TOPICS = {
@@ -64,13 +64,15 @@ _GROUND_TRUTH_TOPICS = {
     "failure_status-elevator": "elevator",
     "failure_status-rudder": "rudder",
     "failure_status-aileron": "aileron",
+    # not ALFA's: written by data.inject for an injected sensor fault
+    "failure_status-sensor": "sensor",
 }
 
 #: How far a row may lie outside the flight's span (the topics' median first and
 #: last rows), s. In ALFA every topic starts and ends within 0.3 s of the median.
 MAX_OUTSIDE_S = 60.0
 
-_LABEL_CLASSES = re.compile(r"engine|rudder|elevator|aileron")
+_LABEL_CLASSES = re.compile(r"engine|rudder|elevator|aileron|sensor")
 
 _FLIGHT_NAME = re.compile(
     r"^carbonZ_(?P<date>\d{4}-\d{2}-\d{2})-(?P<time>\d{2}-\d{2}-\d{2})"
@@ -167,6 +169,9 @@ class Fault:
         (0.2 s in July 2018, 0.5 s later).
     topics : tuple of str
         The ``failure_status-*`` topics present.
+    sensor, kind, magnitude, source : str, str, float, str or None
+        For an injected sensor fault (:mod:`.inject`): the sensor, the kind of fault,
+        its magnitude and the fault-free flight it was injected into.
     codes : dict
         Topic -> distinct ``field.data`` codes in order of appearance.
     """
@@ -176,6 +181,10 @@ class Fault:
     end_s: float | None = None
     topics: tuple[str, ...] = ()
     codes: dict = field(default_factory=dict)
+    sensor: str | None = None
+    kind: str | None = None
+    magnitude: float | None = None
+    source: str | None = None
 
 
 @dataclass(frozen=True)
@@ -318,7 +327,22 @@ def _ground_truth(flight: str, label: str, topics: dict[str, Topic]) -> Fault | 
         end_s=max(float(topics[t].t[-1]) for t in gt),
         topics=tuple(gt),
         codes=codes,
+        **_injected(topics.get("failure_status-sensor")),
     )
+
+
+def _injected(topic: Topic | None) -> dict:
+    if topic is None:
+        return {}
+    first = {c: topic.frame[c].iloc[0] if c in topic.frame else None
+             for c in ("field.sensor", "field.kind", "field.source")}
+    if None in first.values():
+        raise AlfaDataError("an injected fault's ground truth needs field.sensor, "
+                            "field.kind and field.source", flight=topic.flight,
+                            file=topic.file)
+    return {"sensor": str(first["field.sensor"]), "kind": str(first["field.kind"]),
+            "magnitude": float(topic.values("field.magnitude")[0]),
+            "source": str(first["field.source"])}
 
 
 def _check_span(flight: str, raw: dict[str, tuple]) -> None:

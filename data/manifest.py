@@ -51,7 +51,8 @@ SUBSETS = {
 
 COLUMNS = ["flight", "date", "time", "label", "fault_class", "ground_truth",
            "emergency_trajectory", "onset_s", "fault_end_s", "fault_s", "flight_s",
-           "pre_fault_s", "n_topics", "repairs", "sha256", "subsets"]
+           "pre_fault_s", "n_topics", "repairs", "sha256", "subsets", "fault_sensor",
+           "fault_kind", "fault_magnitude", "fault_source"]
 
 
 def _schema() -> dict:
@@ -93,6 +94,10 @@ def manifest_row(flight: Flight) -> dict:
         "n_topics": len(flight.topics),
         "repairs": len(flight.repairs),
         "sha256": flight_sha256(flight.path),
+        "fault_sensor": (fault.sensor or "") if fault else "",
+        "fault_kind": (fault.kind or "") if fault else "",
+        "fault_magnitude": fault.magnitude if fault else None,
+        "fault_source": (fault.source or "") if fault else "",
     }
     row["subsets"] = ";".join(name for name, rule in SUBSETS.items() if rule(row))
     return row
@@ -161,10 +166,13 @@ def validate_manifest(manifest: pd.DataFrame) -> None:
 
 def read_manifest(path: str | Path) -> pd.DataFrame:
     """Read ``data/flights.csv`` back with its types, and validate it."""
-    manifest = pd.read_csv(path, dtype={"date": str, "time": str, "subsets": str},
-                           keep_default_na=False, na_values={c: [""] for c in
-                           ("onset_s", "fault_end_s", "fault_s", "pre_fault_s")})
-    manifest["subsets"] = manifest["subsets"].fillna("")
+    text = {c: str for c in ("date", "time", "subsets", "fault_sensor", "fault_kind",
+                             "fault_source")}
+    manifest = pd.read_csv(path, dtype=text, keep_default_na=False, na_values={
+        c: [""] for c in ("onset_s", "fault_end_s", "fault_s", "pre_fault_s",
+                          "fault_magnitude")})
+    for c in ("subsets", "fault_sensor", "fault_kind", "fault_source"):
+        manifest[c] = manifest[c].fillna("")
     validate_manifest(manifest)
     return manifest
 

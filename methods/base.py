@@ -58,6 +58,11 @@ class Detector(ABC):
     def channels(self) -> tuple[str, ...]:
         """Names of the score channels."""
 
+    @abstractmethod
+    def channel_outputs(self) -> tuple[str, ...]:
+        """Per channel, the measured signal whose behaviour it scores: what the
+        channel isolates when it alarms first."""
+
     def fit(self, segments: list[Sampled]) -> Detector:
         """Learn from fault-free ``segments`` (sampled with :meth:`signals` at
         :attr:`rate_hz`); return self. Uncalibrated detectors learn nothing here."""

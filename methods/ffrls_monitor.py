@@ -170,6 +170,9 @@ class FfRlsMonitor(Detector):
     def channels(self) -> tuple[str, ...]:
         return tuple(f"{m['name']}_{test}" for m in self.models for test in ("residual", "joint"))
 
+    def channel_outputs(self) -> tuple[str, ...]:
+        return tuple(m["output"] for m in self.models for _ in ("residual", "joint"))
+
     def thresholds(self) -> np.ndarray:
         self._check_fitted("gamma_r_")
         return np.array([g for m in self.models for g in (self.gamma_r_[m["name"]], 1.0)])

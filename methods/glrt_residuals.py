@@ -106,6 +106,9 @@ class GlrtResiduals(Detector):
     def channels(self) -> tuple[str, ...]:
         return tuple(p["name"] for p in self.pairs)
 
+    def channel_outputs(self) -> tuple[str, ...]:
+        return tuple(p["output"] for p in self.pairs)
+
     def thresholds(self) -> np.ndarray:
         self._check_fitted("threshold_")
         return self.threshold_.copy()

@@ -89,6 +89,9 @@ class KalmanOkid(Detector):
     def channels(self) -> tuple[str, ...]:
         return tuple(self.outputs)
 
+    def channel_outputs(self) -> tuple[str, ...]:
+        return tuple(self.outputs)
+
     def thresholds(self) -> np.ndarray:
         self._check_fitted("threshold_")
         return self.threshold_.copy()

@@ -173,6 +173,9 @@ class RlsArxZscore(Detector):
     def channels(self) -> tuple[str, ...]:
         return tuple(p["name"] for p in self.pairs)
 
+    def channel_outputs(self) -> tuple[str, ...]:
+        return tuple(p["output"] for p in self.pairs)
+
     def thresholds(self) -> np.ndarray:
         return np.full(len(self.pairs), float(self.z_threshold))
 

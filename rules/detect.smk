@@ -4,13 +4,13 @@ import json
 rule detect:
     input:
         manifest="data/flights.csv",
+        processed=PROCESSED,
     output:
         detections=directory("results/detections/{method}"),
         traces=directory("results/traces/{method}"),
     params:
         # canonical JSON, so that only a changed value (not a reordered key) re-runs it
         spec=lambda w: json.dumps(config["methods"][w.method], sort_keys=True),
-        processed=str(PROCESSED),
         calibration=config["calibration"],
         strict=config["strict"],
     log:

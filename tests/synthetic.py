@@ -1,7 +1,8 @@
 """Small synthetic flights in ALFA's on-disk format, made by the tests themselves.
 
-Roll and pitch follow a known first-order ARX law from their commands, and the body
-rates (``imu-data_raw``, 10 Hz) a known law from the servo outputs (``rc-out``, 3 Hz);
+Roll and pitch follow a known first-order ARX law from their commands, airspeed
+another, and the body rates (``imu-data_raw``, 10 Hz) a known law from the servo
+outputs (``rc-out``, 3 Hz);
 after the fault onset both laws change (the control surface stops answering), which
 is the kind of change the detectors are built to see.
 """
@@ -102,7 +103,19 @@ def write_flight(processed: Path, name: str, *, duration_s: float = 80.0, rate_h
         gt_ns = T0_NS + 1_000_000 + np.round(gt_t * 1e9).astype(np.int64)
         write_csv(folder / f"{name}-{fault_topic}.csv", "%time,field.data",
                   [f"{t},{code}" for t in gt_ns.tolist()])
+    airspeed_topic(folder, name, t_ns + 5_000_000, rate_hz, np.random.default_rng(seed + 1000))
     return folder
+
+
+def airspeed_topic(folder: Path, name: str, t_ns: np.ndarray, rate_hz: float,
+                   rng: np.random.Generator) -> None:
+    """nav_info-airspeed: a first-order response to a stepped airspeed command (m/s),
+    unaffected by the synthetic faults."""
+    n = t_ns.size
+    commanded = 15.0 + np.repeat(rng.uniform(-2, 2, size=n // 200 + 1), 200)[:n]
+    measured = 15.0 + arx_response(commanded - 15.0, 0.95, 0.05, rng.normal(0, 0.05, n))
+    write_csv(folder / f"{name}-mavros-nav_info-airspeed.csv", ATTITUDE_HEADER,
+              attitude_rows(t_ns, commanded, measured))
 
 
 def rename_flight(folder: Path, name: str) -> Path:

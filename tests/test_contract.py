@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import yaml
 
-from alfa_bench.data import load_flight, sample
+from alfa_bench.data import SIGNALS, load_flight, sample
 from alfa_bench.methods import (
     REGISTRY,
     Detector,
@@ -86,6 +86,12 @@ def test_outputs_have_the_declared_shape(detector, one_flight):
     assert trace.score.shape == trace.alarm.shape == (trace.t.size, len(detector.channels()))
     assert trace.alarm.dtype == bool
     assert np.all(np.diff(trace.t) > 0)
+
+
+def test_each_channel_names_the_measured_signal_it_scores(detector):
+    outputs = detector.channel_outputs()
+    assert len(outputs) == len(detector.channels())
+    assert set(outputs) <= set(detector.signals()) and set(outputs) <= set(SIGNALS)
 
 
 def test_alarm_is_score_above_threshold(detector, one_flight):

@@ -1,0 +1,189 @@
+r"""Sensor faults injected into fault-free ALFA flights (Heredia and Ollero, 2011, Sec. 5).
+
+:func:`inject_sensor_fault` writes a new flight, in ALFA's on-disk format, that is a
+fault-free flight with one sensor corrupted from an onset on. Only the sensor's
+column of its topic changes, and only in rows recorded at or after the onset; every
+other cell, row and file is the source's, byte for byte. With :math:`v` the recorded
+value, :math:`r` the range (max - min) of the sensor over the source flight, :math:`m`
+the magnitude and :math:`t_0` the onset:
+
+============  =================================================  ================
+kind          value from the onset                               paper
+============  =================================================  ================
+``stuck``     the last value recorded before the onset           stuck, constant
+``zero``      0                                                  stuck at zero
+``drift``     :math:`v + m r`                                    additive (drift)
+``scale``     :math:`m v` (output at :math:`100 m` % of nominal) multiplicative
+``noise``     :math:`v + \mathcal N(0, (m r)^2)`, seeded         (beyond)
+``ramp``      :math:`v + m r (t - t_0) / 60\,\mathrm{s}`         (beyond)
+============  =================================================  ================
+
+Ground truth is a ``failure_status-sensor`` topic with one row per corrupted row
+(same ``%time``), holding the sensor, kind, magnitude and source flight, so the data layer, every
+method and the scoring read it as they read ALFA's own ``failure_status`` topics.
+The new flight is named ``<source date-time>_<part>_sensor_<sensor>_<kind><100 m>
+_at<onset s>_failure``.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import shutil
+import zlib
+from pathlib import Path
+
+import numpy as np
+
+from .errors import AlfaDataError
+from .flight import Flight, load_flight, parse_flight_name
+from .signals import SIGNALS
+
+log = logging.getLogger("alfa_bench.data")
+
+__all__ = ["KINDS", "RAMP_S", "SENSORS", "inject_grid", "inject_sensor_fault", "injected_name"]
+
+#: The sensors a fault can be injected into: the measured signals.
+SENSORS = ("roll", "pitch", "yaw", "airspeed", "roll_rate", "pitch_rate", "yaw_rate")
+KINDS = ("stuck", "zero", "drift", "scale", "noise", "ramp")
+#: A ramp grows by magnitude x range every RAMP_S seconds.
+RAMP_S = 60.0
+GROUND_TRUTH = "failure_status-sensor"
+
+
+def injected_name(source: str, sensor: str, kind: str, magnitude: float,
+                  onset_s: float) -> str:
+    """The folder name of the flight :func:`inject_sensor_fault` writes."""
+    meta = parse_flight_name(source)
+    size = "" if kind in ("stuck", "zero") else f"{round(100 * magnitude)}"
+    return (f"carbonZ_{meta['date']}-{meta['time']}_{meta['part'] or 0}_sensor_{sensor}_"
+            f"{kind}{size}_at{round(onset_s)}_failure")
+
+
+def inject_sensor_fault(source: str | Path | Flight, processed: str | Path, sensor: str,
+                        kind: str, magnitude: float, onset_s: float, *, topics=None,
+                        seed: int = 0) -> Path:
+    """Write ``source`` with ``sensor`` corrupted from ``onset_s`` (s on its flight
+    clock) under ``processed``; return the new flight's folder.
+
+    Parameters
+    ----------
+    source : path or Flight
+        A fault-free flight (label ``no_failure``), its folder or loaded.
+    sensor : str
+        One of :data:`SENSORS`.
+    kind : str
+        One of :data:`KINDS` (table above).
+    magnitude : float
+        :math:`m`, a fraction of the sensor's range (drift, noise, ramp) or of its
+        nominal output (scale); unused for ``stuck`` and ``zero``.
+    topics : collection of str, optional
+        The topics to write (default all); the sensor's and the ground truth are
+        always written.
+    seed : int
+        Seeds the noise, with the new flight's name.
+    """
+    if sensor not in SENSORS:
+        raise ValueError(f"sensor must be one of {SENSORS}, got {sensor!r}")
+    if kind not in KINDS:
+        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
+    flight = source if isinstance(source, Flight) else load_flight(source)
+    source = flight.path
+    if flight.fault is None or flight.fault.fault_class != "none":
+        raise AlfaDataError("faults are injected into fault-free flights only",
+                            flight=flight.id)
+    sig = SIGNALS[sensor]
+    topic = flight.topic(sig.topic)
+    if not topic.t[0] < onset_s <= topic.t[-1]:
+        raise ValueError(f"onset {onset_s} s is outside {sig.topic} "
+                         f"({topic.t[0]:.2f}-{topic.t[-1]:.2f} s)")
+    name = injected_name(flight.id, sensor, kind, magnitude, onset_s)
+    dest = Path(processed) / name
+    dest.mkdir(parents=True)
+    values = topic.values(sig.column)
+    span = float(values.max() - values.min())
+    for f in sorted(source.glob(f"{flight.id}-*.csv")):
+        name_of_topic = f.name[len(flight.id) + 1:-len(".csv")]
+        if topics is None or name_of_topic in topics or name_of_topic == sig.topic:
+            _link(f, dest / f"{name}-{name_of_topic}.csv")
+    path = dest / f"{name}-{sig.topic}.csv"
+    rng = np.random.default_rng([seed, zlib.crc32(name.encode())])
+    times = _rewrite(path, sig.column, flight.t0_ns + round(onset_s * 1e9),
+                     lambda v, held, dt: _corrupt(kind, v, held, dt, magnitude, span, rng))
+    rows = [f"{t},1,{sensor},{kind},{magnitude!r},{flight.id}" for t in times]
+    header = "%time,field.data,field.sensor,field.kind,field.magnitude,field.source"
+    (dest / f"{name}-{GROUND_TRUTH}.csv").write_text("\n".join([header, *rows]) + "\n")
+    return dest
+
+
+def inject_grid(processed: Path, manifest, out: Path, sensors, faults, onsets) -> list[Path]:
+    """Every fault-free flight of ``manifest`` (under ``processed``) with every sensor
+    of ``sensors`` corrupted by every fault of ``faults`` (``{"kind", "magnitude"}``)
+    from every onset of ``onsets`` (fractions of the flight's duration); only the
+    topics of :data:`~.signals.SIGNALS` are written. A sensor whose topic a flight
+    lacks is skipped there, with a warning. Returns the new folders."""
+    topics = {s.topic for s in SIGNALS.values()}
+    written = []
+    for row in manifest[manifest["fault_class"] == "none"].itertuples():
+        source = load_flight(Path(processed) / row.flight)
+        for sensor in sensors:
+            if SIGNALS[sensor].topic not in source.topics:
+                log.warning("%s: no %s topic, so no %s faults", row.flight,
+                            SIGNALS[sensor].topic, sensor)
+                continue
+            for fault in faults:
+                for share in onsets:
+                    written.append(inject_sensor_fault(
+                        source, out, sensor, fault["kind"],
+                        float(fault["magnitude"]), round(share * row.flight_s, 2),
+                        topics=topics))
+        log.info("%s: sensor faults injected", row.flight)
+    return written
+
+
+def _corrupt(kind, v, held, dt, m, span, rng):
+    match kind:
+        case "stuck":
+            return held
+        case "zero":
+            return 0.0
+        case "drift":
+            return v + m * span
+        case "scale":
+            return m * v
+        case "noise":
+            return v + rng.normal(0.0, m * span)
+        case "ramp":
+            return v + m * span * dt / RAMP_S
+
+
+def _link(src: Path, dst: Path) -> None:
+    """``dst`` with the bytes of ``src``: a hard link where the file system allows."""
+    try:
+        os.link(src, dst)
+    except OSError:
+        shutil.copyfile(src, dst)
+
+
+def _rewrite(path: Path, column: str, onset_ns: int, corrupt) -> list[int]:
+    """Replace ``column`` in the rows of ``path`` at or after ``onset_ns`` by
+    ``corrupt(value, last value before onset, seconds since onset)``; every other
+    byte is kept. Returns the ``%time`` of the rows changed."""
+    text = path.read_text()
+    path.unlink()          # it may be a hard link to the source
+    lines = text.split("\n")
+    j = lines[0].split(",").index(column)
+    held, changed = None, []
+    for i in range(1, len(lines)):
+        if not lines[i]:
+            continue
+        cells = lines[i].split(",")
+        t = int(cells[0])
+        if t < onset_ns:
+            held = float(cells[j])
+            continue
+        cells[j] = repr(float(corrupt(float(cells[j]), held, (t - onset_ns) * 1e-9)))
+        lines[i] = ",".join(cells)
+        changed.append(t)
+    path.write_text("\n".join(lines))
+    return changed
