@@ -18,7 +18,15 @@ from pathlib import Path
 
 import pandas as pd
 
-from alfa_bench.data import FAILURE_COLUMNS, AlfaDataError, Flight, failure_row
+from alfa_bench.data import (
+    FAILURE_COLUMNS,
+    SIGNALS,
+    AlfaDataError,
+    Flight,
+    failure_row,
+    not_measured,
+    reads_actuators,
+)
 from alfa_bench.methods import (
     Detector,
     Trace,
@@ -92,10 +100,14 @@ def detect_all(method: str, spec: dict, flights: dict[str, Flight], manifest: pd
             continue
         segments = {f: guarded("calibration", f, lambda f=f: fault_free_segments(
             detector, [flights[f]], calibration["margin_s"])) for f in training}
-        used = [f for f in training if segments[f] is not None]
+        readable = [f for f in training if segments[f] is not None]
+        dead = {f: list(d) for f in readable
+                if (d := not_measured(flights[f], detector.signals()))}
+        used = [f for f in readable if f not in dead]
         detector.fit([s for f in used for s in segments[f]])
         log.info("%s: fold %s fitted on %d flights", method, fold, len(used))
-        info = {**calibration, "fold": fold, "flights": used, "fitted": detector.fitted()}
+        info = {**calibration, "fold": fold, "flights": used, "not_measured": dead,
+                "fitted": detector.fitted()}
         for name in scored:
             if (out := run(name, info)) is not None:
                 yield out
@@ -119,18 +131,24 @@ def detection_record(method: str, spec: dict, detector: Detector, flight: Flight
         "flight": flight.id,
         "method": method,
         "detector": spec["detector"],
+        "role": spec.get("role", "method"),
+        # whether it reads what the fault emulation writes: from its signals, never set
+        "reads_actuators": reads_actuators(detector.signals()),
+        "signal_kinds": {n: SIGNALS[n].kind for n in detector.signals()},
         "parameters": detector.get_params(),
         "fault_class": flight.fault.fault_class,
         "fault_sensor": flight.fault.sensor,
         "onset_s": onset,
         "fault_end_s": flight.fault.end_s,
         "first_alarm_s": first,
+        # by the paper's rule (no deadline); the tables score deadlines from first_alarm_s
         "detection_s": first - onset if outcome == "TP" else None,
         "outcome": outcome,
         "alarm_intervals": trace.alarm_intervals(),
         "pair_first_alarm_s": {ch: trace.first_alarm_s(i)
                                for i, ch in enumerate(trace.channels)},
         "pair_armed_s": {ch: trace.armed_s(i) for i, ch in enumerate(trace.channels)},
+        "skipped_channels": trace.skipped,
         "channel_outputs": dict(zip(trace.channels, detector.channel_outputs(), strict=True)),
         "grid": {"rate_hz": detector.rate_hz, "samples": int(trace.t.size),
                  "start_s": float(trace.t[0]), "stop_s": float(trace.t[-1])},

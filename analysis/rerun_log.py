@@ -51,9 +51,11 @@ _RED = (220, 40, 40)
 def signal_group(name: str) -> str:
     """The view a signal is drawn in."""
     sig = SIGNALS[name]
+    if sig.kind == "actuator":
+        return "servos"      # the outputs the fault emulation writes, throttle included
     if sig.unit == "deg":
         return "attitude_error" if sig.minus else "attitude"
-    return {"rad/s": "rates", "us": "servos", "m/s": "airspeed"}[sig.unit]
+    return {"rad/s": "rates", "m/s": "airspeed"}[sig.unit]
 
 
 def blueprint(methods: list[str], groups: list[str]) -> rrb.Blueprint:

@@ -11,12 +11,22 @@ from .manifest import (
     scan_flights,
     subset_flights,
 )
-from .signals import MAX_HOLD_S, SIGNALS, Sampled, Signal, sample, series
+from .signals import (
+    KINDS,
+    MAX_HOLD_S,
+    SIGNALS,
+    Sampled,
+    Signal,
+    not_measured,
+    reads_actuators,
+    sample,
+    series,
+)
 
 __all__ = [
-    "FAILURE_COLUMNS", "FAULT_CLASSES", "MAX_HOLD_S", "SIGNALS", "SUBSETS", "AlfaDataError",
-    "Fault", "Flight", "MissingTopicError", "Sampled", "Signal", "Topic", "build_manifest",
-    "failure_row", "fetch_alfa", "find_flights", "load_flight", "name_subsets",
-    "processed_dir", "read_manifest", "resolve_alfa_dir", "sample", "scan_flights", "series",
-    "subset_flights",
+    "FAILURE_COLUMNS", "FAULT_CLASSES", "KINDS", "MAX_HOLD_S", "SIGNALS", "SUBSETS",
+    "AlfaDataError", "Fault", "Flight", "MissingTopicError", "Sampled", "Signal", "Topic",
+    "build_manifest", "failure_row", "fetch_alfa", "find_flights", "load_flight",
+    "name_subsets", "not_measured", "processed_dir", "read_manifest", "reads_actuators",
+    "resolve_alfa_dir", "sample", "scan_flights", "series", "subset_flights",
 ]

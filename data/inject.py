@@ -37,7 +37,7 @@ import numpy as np
 
 from .errors import AlfaDataError
 from .flight import Flight, load_flight, parse_flight_name
-from .signals import SIGNALS
+from .signals import SIGNALS, not_measured
 
 log = logging.getLogger("alfa_bench.data")
 
@@ -94,6 +94,10 @@ def inject_sensor_fault(source: str | Path | Flight, processed: str | Path, sens
                             flight=flight.id)
     sig = SIGNALS[sensor]
     topic = flight.topic(sig.topic)
+    if not_measured(flight, [sensor]):
+        raise AlfaDataError(f"{sensor} is not measured on this flight (constant over all of "
+                            "it): a fault injected there would corrupt a value that is not "
+                            "there", flight=flight.id, file=topic.file, column=sig.column)
     if not topic.t[0] < onset_s <= topic.t[-1]:
         raise ValueError(f"onset {onset_s} s is outside {sig.topic} "
                          f"({topic.t[0]:.2f}-{topic.t[-1]:.2f} s)")
@@ -116,20 +120,27 @@ def inject_sensor_fault(source: str | Path | Flight, processed: str | Path, sens
     return dest
 
 
-def inject_grid(processed: Path, manifest, out: Path, sensors, faults, onsets) -> list[Path]:
+def inject_grid(processed: Path, manifest, out: Path, sensors, faults,
+                onsets) -> tuple[list[Path], list[dict]]:
     """Every fault-free flight of ``manifest`` (under ``processed``) with every sensor
     of ``sensors`` corrupted by every fault of ``faults`` (``{"kind", "magnitude"}``)
     from every onset of ``onsets`` (fractions of the flight's duration); only the
     topics of :data:`~.signals.SIGNALS` are written. A sensor whose topic a flight
-    lacks is skipped there, with a warning. Returns the new folders."""
+    lacks, or that the flight does not measure (the manifest's ``not_measured``), is
+    skipped there, with a warning. Returns the new folders, and the skipped
+    ``{"flight", "sensor", "reason"}``."""
     topics = {s.topic for s in SIGNALS.values()}
-    written = []
+    written, skipped = [], []
     for row in manifest[manifest["fault_class"] == "none"].itertuples():
         source = load_flight(Path(processed) / row.flight)
+        dead = set(str(row.not_measured).split(";"))
         for sensor in sensors:
-            if SIGNALS[sensor].topic not in source.topics:
-                log.warning("%s: no %s topic, so no %s faults", row.flight,
-                            SIGNALS[sensor].topic, sensor)
+            reason = (f"no {SIGNALS[sensor].topic} topic"
+                      if SIGNALS[sensor].topic not in source.topics else
+                      "not measured (constant over the flight)" if sensor in dead else None)
+            if reason:
+                log.warning("%s: %s: %s, so no faults injected", row.flight, sensor, reason)
+                skipped.append({"flight": row.flight, "sensor": sensor, "reason": reason})
                 continue
             for fault in faults:
                 for share in onsets:
@@ -138,7 +149,7 @@ def inject_grid(processed: Path, manifest, out: Path, sensors, faults, onsets) -
                         float(fault["magnitude"]), round(share * row.flight_s, 2),
                         topics=topics))
         log.info("%s: sensor faults injected", row.flight)
-    return written
+    return written, skipped
 
 
 def _corrupt(kind, v, held, dt, m, span, rng):

@@ -32,6 +32,7 @@ import pandas as pd
 
 from .errors import FAILURE_COLUMNS, AlfaDataError, failure_row
 from .flight import Flight, find_flights, load_flight, parse_flight_name
+from .signals import not_measured
 
 __all__ = ["ICRA22_LAST_DATE", "SUBSETS", "build_manifest", "flight_sha256", "manifest_row",
            "name_subsets", "read_manifest", "scan_flights", "subset_flights",
@@ -52,7 +53,7 @@ SUBSETS = {
 COLUMNS = ["flight", "date", "time", "label", "fault_class", "ground_truth",
            "emergency_trajectory", "onset_s", "fault_end_s", "fault_s", "flight_s",
            "pre_fault_s", "n_topics", "repairs", "sha256", "subsets", "fault_sensor",
-           "fault_kind", "fault_magnitude", "fault_source"]
+           "fault_kind", "fault_magnitude", "fault_source", "not_measured"]
 
 
 def _schema() -> dict:
@@ -98,6 +99,9 @@ def manifest_row(flight: Flight) -> dict:
         "fault_kind": (fault.kind or "") if fault else "",
         "fault_magnitude": fault.magnitude if fault else None,
         "fault_source": (fault.source or "") if fault else "",
+        # catalogue signals constant over the whole flight (measured airspeed from
+        # 2018-09-11 on): a method skips its channels on them
+        "not_measured": ";".join(not_measured(flight)),
     }
     row["subsets"] = ";".join(name for name, rule in SUBSETS.items() if rule(row))
     return row
@@ -167,11 +171,11 @@ def validate_manifest(manifest: pd.DataFrame) -> None:
 def read_manifest(path: str | Path) -> pd.DataFrame:
     """Read ``data/flights.csv`` back with its types, and validate it."""
     text = {c: str for c in ("date", "time", "subsets", "fault_sensor", "fault_kind",
-                             "fault_source")}
+                             "fault_source", "not_measured")}
     manifest = pd.read_csv(path, dtype=text, keep_default_na=False, na_values={
         c: [""] for c in ("onset_s", "fault_end_s", "fault_s", "pre_fault_s",
                           "fault_magnitude")})
-    for c in ("subsets", "fault_sensor", "fault_kind", "fault_source"):
+    for c in ("subsets", "fault_sensor", "fault_kind", "fault_source", "not_measured"):
         manifest[c] = manifest[c].fillna("")
     validate_manifest(manifest)
     return manifest

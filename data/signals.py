@@ -16,6 +16,22 @@ ALFA topics are sample-and-hold streams (``nav_info`` roll and pitch rows come a
 ~19.5 Hz, but the measured value changes at ~2.5 Hz). :func:`sample` therefore
 also returns, per signal, whether each grid value is *fresh*: it comes from a row
 whose measured field changed since the previous grid point.
+
+Every signal has a *kind*, by where it sits relative to ALFA's fault emulation:
+
+``sensor``
+    a measurement of the aircraft's state (attitude, body rates, airspeed);
+``setpoint``
+    the autopilot's command, upstream of the emulation (commanded attitude and
+    airspeed, and the attitude errors against them);
+``actuator``
+    written by the emulation itself: every servo output of ``rc-out`` and the
+    throttle of ``vfr_hud``. At onset the failed actuator's output goes flat (the
+    throttle to zero), so a method reading these reads the label, not the fault.
+
+:func:`reads_actuators` tells, from a method's signal names alone, whether it reads
+such a signal; nobody sets it by hand. :func:`not_measured` finds signals that are
+constant over a whole flight (measured airspeed is 0 from 2018-09-11 on).
 """
 
 from __future__ import annotations
@@ -27,31 +43,43 @@ import numpy as np
 from .errors import AlfaDataError
 from .flight import Flight
 
-__all__ = ["MAX_HOLD_S", "SIGNALS", "Sampled", "Signal", "sample", "series"]
+__all__ = ["KINDS", "MAX_HOLD_S", "SIGNALS", "Sampled", "Signal", "not_measured", "reads_actuators",
+           "sample", "series"]
 
 #: The longest a row's value may be held on the sampling grid, s.
 MAX_HOLD_S = 1.0
+
+#: Signal kinds, by where they sit relative to the fault emulation (module docstring).
+KINDS = ("sensor", "setpoint", "actuator")
 
 
 @dataclass(frozen=True)
 class Signal:
     """A column of a topic, optionally minus another column of the same rows.
 
-    Freshness follows ``column`` (the measured quantity).
+    Freshness follows ``column`` (the measured quantity); ``kind`` is one of
+    :data:`KINDS`.
     """
 
     topic: str
     column: str
+    kind: str
     minus: str | None = None
     unit: str = ""
+
+    def __post_init__(self):
+        if self.kind not in KINDS:
+            raise ValueError(f"signal kind must be one of {KINDS}, got {self.kind!r}")
 
 
 def _attitude(axis: str) -> dict[str, Signal]:
     topic = f"mavros-nav_info-{axis}"
     return {
-        f"{axis}_cmd": Signal(topic, "field.commanded", unit="deg"),
-        axis: Signal(topic, "field.measured", unit="deg"),
-        f"{axis}_error": Signal(topic, "field.measured", minus="field.commanded", unit="deg"),
+        f"{axis}_cmd": Signal(topic, "field.commanded", "setpoint", unit="deg"),
+        axis: Signal(topic, "field.measured", "sensor", unit="deg"),
+        # measured minus commanded: a setpoint's deviation, fresh with the measurement
+        f"{axis}_error": Signal(topic, "field.measured", "setpoint", minus="field.commanded",
+                                unit="deg"),
     }
 
 
@@ -60,17 +88,26 @@ SIGNALS: dict[str, Signal] = {
     **_attitude("roll"),
     **_attitude("pitch"),
     **_attitude("yaw"),
-    "airspeed_cmd": Signal("mavros-nav_info-airspeed", "field.commanded", unit="m/s"),
-    "airspeed": Signal("mavros-nav_info-airspeed", "field.measured", unit="m/s"),
+    "airspeed_cmd": Signal("mavros-nav_info-airspeed", "field.commanded", "setpoint",
+                           unit="m/s"),
+    "airspeed": Signal("mavros-nav_info-airspeed", "field.measured", "sensor", unit="m/s"),
     # body rates from the raw IMU, the freshest sensor in ALFA (~10 Hz, every row new)
-    "roll_rate": Signal("mavros-imu-data_raw", "field.angular_velocity.x", unit="rad/s"),
-    "pitch_rate": Signal("mavros-imu-data_raw", "field.angular_velocity.y", unit="rad/s"),
-    "yaw_rate": Signal("mavros-imu-data_raw", "field.angular_velocity.z", unit="rad/s"),
+    "roll_rate": Signal("mavros-imu-data_raw", "field.angular_velocity.x", "sensor",
+                        unit="rad/s"),
+    "pitch_rate": Signal("mavros-imu-data_raw", "field.angular_velocity.y", "sensor",
+                         unit="rad/s"),
+    "yaw_rate": Signal("mavros-imu-data_raw", "field.angular_velocity.z", "sensor",
+                       unit="rad/s"),
     # servo outputs (~3 Hz). ALFA does not name the channels; the mapping follows the
-    # data: channels4 and 5 are identical and track roll rate (ailerons, r ~ 0.6-0.9),
-    # channels1 tracks pitch rate (elevator, r ~ 0.6-0.9).
-    "aileron_cmd": Signal("mavros-rc-out", "field.channels4", unit="us"),
-    "elevator_cmd": Signal("mavros-rc-out", "field.channels1", unit="us"),
+    # data: channels4 and 5 track roll rate (ailerons, r ~ 0.6-0.9), channels1 pitch rate
+    # (elevator), channels2 drops to idle at every engine failure (throttle), channels3
+    # is the one left (rudder); channels0, 6 and 7 never move.
+    "servo_elevator": Signal("mavros-rc-out", "field.channels1", "actuator", unit="us"),
+    "servo_throttle": Signal("mavros-rc-out", "field.channels2", "actuator", unit="us"),
+    "servo_rudder": Signal("mavros-rc-out", "field.channels3", "actuator", unit="us"),
+    "servo_aileron_left": Signal("mavros-rc-out", "field.channels4", "actuator", unit="us"),
+    "servo_aileron_right": Signal("mavros-rc-out", "field.channels5", "actuator", unit="us"),
+    "throttle": Signal("mavros-vfr_hud", "field.throttle", "actuator", unit="1"),
 }
 
 
@@ -109,6 +146,35 @@ def series(flight: Flight, name: str) -> tuple[np.ndarray, np.ndarray]:
     tp = flight.topic(sig.topic)
     value = tp.values(sig.column)
     return tp.t, value - tp.values(sig.minus) if sig.minus else value
+
+
+def reads_actuators(names) -> bool:
+    """Whether the signals ``names`` include one the fault emulation writes."""
+    return any(SIGNALS[n].kind == "actuator" for n in names)
+
+
+def not_measured(flight: Flight, names=None) -> tuple[str, ...]:
+    """The sensors among ``names`` (default: every catalogue signal whose topic the
+    flight has) that are constant over the whole flight: not measured on it. A
+    constant setpoint is a command that did not change, and a constant actuator an
+    output not used; neither is missing data.
+
+    With ``names`` None, a column that cannot be read is passed over: it is an error
+    only for a method that reads it (:func:`sample` raises it then)."""
+    survey = names is None
+    if survey:
+        names = [n for n, sig in SIGNALS.items() if sig.topic in flight.topics]
+    dead = []
+    for name in (n for n in names if SIGNALS[n].kind == "sensor"):
+        try:
+            value = series(flight, name)[1]
+        except AlfaDataError:
+            if survey:
+                continue
+            raise
+        if value.size and np.all(value == value[0]):
+            dead.append(name)
+    return tuple(dead)
 
 
 def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float,

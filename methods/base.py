@@ -14,19 +14,29 @@ A *calibrated* detector also learns from fault-free data before it runs:
 pre-fault parts of the others, never the flight to be scored) and sets its fitted
 attributes (ending in ``_``, kept by :meth:`~Detector.reset`);
 :meth:`~Detector.fitted` reports them for the detection record.
+
+A signal that is not measured on a flight (constant over all of it, like measured
+airspeed from 2018-09-11 on) is never modelled: :func:`run_detector` skips the
+channels that score it, or every channel when a model input is dead
+(:func:`skipped_channels`), and :func:`fault_free_segments` leaves such flights out
+of calibration. Both are logged and recorded.
 """
 
 from __future__ import annotations
 
 import inspect
+import logging
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from alfa_bench.data import Flight, Sampled, sample
+from alfa_bench.data import Flight, Sampled, not_measured, sample
 
-__all__ = ["Detector", "NotFittedError", "Trace", "fault_free_segments", "run_detector"]
+__all__ = ["Detector", "NotFittedError", "Trace", "fault_free_segments", "run_detector",
+           "skipped_channels"]
+
+log = logging.getLogger(__name__)
 
 
 class NotFittedError(RuntimeError):
@@ -44,6 +54,9 @@ class Detector(ABC):
     rate_hz: float
     #: whether :meth:`fit` must see fault-free data before the detector can run
     calibrated: bool = False
+    #: whether each output depends on the data up to then only; a detector that is
+    #: not may serve only as a reference row (``role: reference`` in the config)
+    causal: bool = True
 
     def get_params(self) -> dict:
         """Hyper-parameters by name, as passed to ``__init__``."""
@@ -141,6 +154,8 @@ class Trace:
     threshold : ndarray, shape (c,)
     probes : dict of str to ndarray, shape (n,)
         :meth:`Detector.probes` per step, when asked for.
+    skipped : dict of str to str
+        Channels skipped on this flight (score NaN, never alarming), and why.
     """
 
     t: np.ndarray
@@ -149,6 +164,7 @@ class Trace:
     channels: tuple[str, ...]
     threshold: np.ndarray
     probes: dict = field(default_factory=dict)
+    skipped: dict = field(default_factory=dict)
 
     @property
     def any_alarm(self) -> np.ndarray:
@@ -171,13 +187,34 @@ class Trace:
         return [(float(self.t[s]), float(self.t[e - 1])) for s, e in edges.reshape(-1, 2)]
 
 
+def skipped_channels(detector: Detector, dead) -> dict[str, str]:
+    """Channels of ``detector`` to skip when the signals ``dead`` are not measured: a
+    channel scoring a dead output, and every channel when a dead signal is an input
+    (no model is driven by a signal that is not there)."""
+    dead = [d for d in detector.signals() if d in set(dead)]
+    if not dead:
+        return {}
+    outputs = detector.channel_outputs()
+    inputs = [d for d in dead if d not in outputs]
+    return {ch: (f"input {inputs[0]} not measured" if inputs else f"{out} not measured")
+            for ch, out in zip(detector.channels(), outputs, strict=True)
+            if inputs or out in dead}
+
+
 def run_detector(detector: Detector, flight: Flight, probes: bool = False) -> Trace:
     """Run ``detector`` causally over ``flight``, from a fresh state; with ``probes``,
-    keep :meth:`Detector.probes` of every step."""
+    keep :meth:`Detector.probes` of every step. Channels on signals the flight does not
+    measure are skipped (:func:`skipped_channels`)."""
     s = sample(flight, detector.signals(), detector.rate_hz)
     score, alarm, kept = detector.run(s, probes)
+    skipped = skipped_channels(detector, not_measured(flight, detector.signals()))
+    if skipped:
+        cols = [detector.channels().index(ch) for ch in skipped]
+        score[:, cols], alarm[:, cols] = np.nan, False
+        log.info("%s: skipped %s", flight.id, skipped)
     return Trace(t=s.t, score=score, alarm=alarm, channels=detector.channels(),
-                 threshold=np.asarray(detector.thresholds(), dtype=float), probes=kept)
+                 threshold=np.asarray(detector.thresholds(), dtype=float), probes=kept,
+                 skipped=skipped)
 
 
 def fault_free_segments(detector: Detector, flights: list[Flight],
@@ -186,13 +223,19 @@ def fault_free_segments(detector: Detector, flights: list[Flight],
 
     A fault-free flight gives all of itself, a faulty one its grid steps before
     ``onset - margin_s`` (the onset is known only to the ground truth's period). A
-    flight without ground truth cannot tell its fault-free part and is refused.
+    flight without ground truth cannot tell its fault-free part and is refused. A
+    flight that does not measure one of the detector's signals gives nothing (its
+    constant would be modelled as data); it is logged.
     """
     segments = []
     for flight in flights:
         if flight.fault is None:
             raise ValueError(f"flight {flight.id} has no ground truth: its fault-free part "
                              "is unknown, so it cannot calibrate")
+        dead = not_measured(flight, detector.signals())
+        if dead:
+            log.info("%s left out of calibration: %s not measured", flight.id, list(dead))
+            continue
         s = sample(flight, detector.signals(), detector.rate_hz)
         if flight.fault.onset_s is not None:
             s = s.before(flight.fault.onset_s - margin_s)

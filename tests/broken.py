@@ -38,7 +38,7 @@ GT = "failure_status-engines"
 
 #: the detector of :func:`outcome`: one pair per topic family a method reads
 PAIRS = [{"name": "roll", "input": "roll_cmd", "output": "roll"},
-         {"name": "p", "input": "aileron_cmd", "output": "roll_rate"}]
+         {"name": "p", "input": "servo_aileron_left", "output": "roll_rate"}]
 
 
 @dataclass(frozen=True)

@@ -46,16 +46,49 @@ RC_HEADER = ("%time,field.header.seq,field.header.stamp,field.header.frame_id,"
              + ",".join(f"field.channels{i}" for i in range(8)))
 
 
+VFR_HUD_HEADER = ("%time,field.airspeed,field.groundspeed,field.heading,field.throttle,"
+                  "field.altitude,field.climb")
+
+#: the rc-out channels ALFA's emulation freezes at onset, by ground-truth topic and code
+EMULATED_CHANNELS = {("failure_status-engines", 1): [2], ("failure_status-elevator", 1): [1],
+                     ("failure_status-rudder", 1): [3], ("failure_status-rudder", 2): [3],
+                     ("failure_status-rudder", 3): [3], ("failure_status-aileron", 1): [5],
+                     ("failure_status-aileron", 2): [4], ("failure_status-aileron", 3): [4, 5]}
+
+
 def rate_topics(folder: Path, name: str, duration_s: float, onset_s: float | None,
-                rng: np.random.Generator) -> None:
+                rng: np.random.Generator, emulation: tuple[str, int] | None = None,
+                emulate_surfaces: bool = False, seed: int = 0) -> None:
     """rc-out at 3 Hz and the body rates at 10 Hz answering the held servo outputs:
-    p = 2.5 da, q = 2 de, r(k) = 0.9 r(k-1) + 0.1 da (p and q stop answering at onset)."""
+    p = 2.5 da, q = 2 de, r(k) = 0.9 r(k-1) + 0.1 da (p and q stop answering at onset).
+
+    Throttle (channel 2) and rudder (channel 3) move at random, and ``vfr_hud`` carries
+    the throttle at 2.5 Hz, from a random stream of their own (``seed``). As ALFA's
+    emulation does, the failed actuator of ``emulation`` (ground-truth topic, code)
+    goes flat at onset: the throttle to idle (vfr_hud to 0), the rudder where it is;
+    the elevator and aileron channels too with ``emulate_surfaces``."""
     rc_t = np.arange(0.0, duration_s, 1 / 3)
     da = 0.3 * np.sin(0.8 * rc_t) + rng.uniform(-0.2, 0.2, rc_t.size)
     de = 0.2 * np.sin(0.5 * rc_t + 1) + rng.uniform(-0.2, 0.2, rc_t.size)
     pwm = np.full((rc_t.size, 8), 1500)
     pwm[:, 4] = pwm[:, 5] = np.round(1500 + 500 * da)
     pwm[:, 1] = np.round(1500 + 500 * de)
+    own = np.random.default_rng(seed + 2000)
+    pwm[:, 2] = np.round(1400 + 300 * own.uniform(size=rc_t.size))
+    pwm[:, 3] = np.round(1500 + 200 * own.uniform(-1, 1, size=rc_t.size))
+    hud_t = np.arange(0.2, duration_s, 0.4)
+    throttle = np.round(own.uniform(0.3, 0.8, size=hud_t.size), 2)
+    failed = EMULATED_CHANNELS.get(emulation, []) if onset_s is not None else []
+    for ch in failed:
+        if ch in (2, 3) or emulate_surfaces:
+            after = rc_t >= onset_s
+            pwm[after, ch] = 1100 if ch == 2 else pwm[np.argmax(after), ch]
+    if 2 in failed:
+        throttle[hud_t >= onset_s] = 0.0
+    hud_ns = T0_NS + 4_000_000 + np.round(hud_t * 1e9).astype(np.int64)
+    write_csv(folder / f"{name}-mavros-vfr_hud.csv", VFR_HUD_HEADER,
+              [f"{t},0.0,15.0,90,{u!r},100.0,0.0"
+               for t, u in zip(hud_ns.tolist(), throttle.tolist(), strict=True)])
     rc_ns = T0_NS + 2_000_000 + np.round(rc_t * 1e9).astype(np.int64)
     write_csv(folder / f"{name}-mavros-rc-out.csv", RC_HEADER,
               [f"{t},{i},{t - 100_000},," + ",".join(map(str, row))
@@ -79,10 +112,12 @@ def write_csv(path: Path, header: str, rows: list[str]) -> None:
 
 def write_flight(processed: Path, name: str, *, duration_s: float = 80.0, rate_hz: float = 20.0,
                  onset_s: float | None = None, fault_topic: str = "failure_status-engines",
-                 code: int = 1, gt_rate_hz: float = 2.0, seed: int = 0) -> Path:
+                 code: int = 1, gt_rate_hz: float = 2.0, seed: int = 0,
+                 emulate_surfaces: bool = False) -> Path:
     """Write flight ``name`` under ``processed`` and return its folder.
 
-    ``onset_s`` None writes a fault-free flight (no failure_status file).
+    ``onset_s`` None writes a fault-free flight (no failure_status file). With
+    ``emulate_surfaces`` the failed surface's servo channel goes flat at onset too.
     """
     rng = np.random.default_rng(seed)
     folder = processed / name
@@ -97,7 +132,8 @@ def write_flight(processed: Path, name: str, *, duration_s: float = 80.0, rate_h
         measured = np.where(faulty, y_fault, y)
         write_csv(folder / f"{name}-mavros-nav_info-{axis}.csv", ATTITUDE_HEADER,
                   attitude_rows(t_ns + i * 3_000_000, u, measured))
-    rate_topics(folder, name, duration_s, onset_s, rng)
+    rate_topics(folder, name, duration_s, onset_s, rng, (fault_topic, code), emulate_surfaces,
+                seed)
     if onset_s is not None:
         gt_t = np.arange(onset_s, duration_s, 1 / gt_rate_hz)
         gt_ns = T0_NS + 1_000_000 + np.round(gt_t * 1e9).astype(np.int64)

@@ -18,7 +18,8 @@ from alfa_bench.methods import Trace, fault_free_segments, make_detector, run_de
 SOURCE = "carbonZ_2018-07-18-16-37-39_1_no_failure"
 
 
-FULL_BANK = {"inputs": ["roll_cmd", "pitch_cmd", "airspeed_cmd", "aileron_cmd", "elevator_cmd"],
+FULL_BANK = {"inputs": ["roll_cmd", "pitch_cmd", "airspeed_cmd", "servo_aileron_left",
+                        "servo_elevator"],
              "outputs": ["roll", "pitch", "airspeed", "roll_rate", "pitch_rate", "yaw_rate"]}
 
 
@@ -77,7 +78,7 @@ def test_a_signal_names_the_sensor_it_reads():
     assert measured_sensor("roll_error") == "roll" and measured_sensor("pitch") == "pitch"
     assert measured_sensor("roll_rate") == "roll_rate"
     with pytest.raises(KeyError):
-        measured_sensor("aileron_cmd")
+        measured_sensor("servo_aileron_left")
     assert SENSOR_ACTUATOR["airspeed"] == "engine"
 
 

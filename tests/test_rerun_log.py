@@ -9,7 +9,7 @@ from alfa_bench.analysis.rerun_log import read_rerun_provenance, write_rerun_log
 from alfa_bench.data import load_flight, series
 from alfa_bench.methods import make_detector, run_detector
 
-SIGNALS = ["roll_cmd", "roll", "roll_error", "roll_rate", "aileron_cmd"]
+SIGNALS = ["roll_cmd", "roll", "roll_error", "roll_rate", "servo_aileron_left"]
 
 
 @pytest.fixture(scope="module")

@@ -1,0 +1,76 @@
+"""A sensor that is not measured on a flight (constant over all of it) is never modelled,
+never alarmed on and never injected into; a constant command is not missing data."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from alfa_bench.data import AlfaDataError, build_manifest, load_flight, not_measured
+from alfa_bench.data.inject import inject_grid, inject_sensor_fault
+from alfa_bench.methods import fault_free_segments, make_detector, run_detector
+from synthetic import write_flight
+
+FREE = "carbonZ_2018-09-11-14-16-55_no_failure"
+BANK = {"inputs": ["roll_cmd", "pitch_cmd"], "outputs": ["roll", "airspeed"]}
+
+
+def kill(folder: Path, topic: str, column: str, value: str = "0.0") -> None:
+    """Set ``column`` of ``topic`` to ``value`` in every row, as ALFA's dead airspeed."""
+    path = folder / f"{folder.name}-{topic}.csv"
+    lines = path.read_text().splitlines()
+    i = lines[0].split(",").index(column)
+    rows = [",".join(c if j != i else value for j, c in enumerate(line.split(",")))
+            for line in lines[1:]]
+    path.write_text("\n".join([lines[0], *rows]) + "\n")
+
+
+@pytest.fixture
+def dead_airspeed(tmp_path):
+    folder = write_flight(tmp_path / "processed", FREE, seed=7)
+    kill(folder, "mavros-nav_info-airspeed", "field.measured")
+    return folder
+
+
+def test_a_constant_sensor_is_not_measured_but_a_constant_command_is_fine(dead_airspeed):
+    kill(dead_airspeed, "mavros-nav_info-airspeed", "field.commanded", "15.0")
+    flight = load_flight(dead_airspeed)
+    assert not_measured(flight) == ("airspeed",)
+    assert build_manifest(dead_airspeed.parent)["not_measured"].tolist() == ["airspeed"]
+
+
+def test_its_channel_is_skipped_and_the_others_still_judge(dead_airspeed, corpus):
+    detector = make_detector("kalman_okid", BANK)
+    detector.fit(fault_free_segments(detector, [load_flight(p) for p in corpus.iterdir()], 1.0))
+    trace = run_detector(detector, load_flight(dead_airspeed))
+    assert trace.skipped == {"airspeed": "airspeed not measured"}
+    assert np.isnan(trace.score[:, 1]).all() and not trace.alarm[:, 1].any()
+    assert np.isfinite(trace.score[:, 0]).any()
+
+
+def test_a_dead_input_skips_every_channel(dead_airspeed, corpus):
+    detector = make_detector("kalman_okid", {"inputs": ["roll_cmd", "airspeed"],
+                                             "outputs": ["roll", "pitch"]})
+    detector.fit(fault_free_segments(detector, [load_flight(p) for p in corpus.iterdir()], 1.0))
+    trace = run_detector(detector, load_flight(dead_airspeed))
+    assert set(trace.skipped) == {"roll", "pitch"} and not trace.alarm.any()
+
+
+def test_calibration_leaves_the_flight_out(dead_airspeed):
+    detector = make_detector("kalman_okid", BANK)
+    assert fault_free_segments(detector, [load_flight(dead_airspeed)], 1.0) == []
+    honest = make_detector("kalman_okid", {})          # roll and pitch only: it is used
+    assert len(fault_free_segments(honest, [load_flight(dead_airspeed)], 1.0)) == 1
+
+
+def test_no_fault_is_injected_into_it(dead_airspeed, tmp_path):
+    with pytest.raises(AlfaDataError, match="not measured") as err:
+        inject_sensor_fault(dead_airspeed, tmp_path / "out", "airspeed", "drift", 0.5, 40.0)
+    assert err.value.column == "field.measured"
+    manifest = build_manifest(dead_airspeed.parent)
+    written, skipped = inject_grid(dead_airspeed.parent, manifest, tmp_path / "grid",
+                                   ["airspeed", "roll"], [{"kind": "drift", "magnitude": 0.5}],
+                                   [0.5])
+    assert [p.name.split("_sensor_")[1].split("_")[0] for p in written] == ["roll"]
+    assert skipped == [{"flight": FREE, "sensor": "airspeed",
+                        "reason": "not measured (constant over the flight)"}]
