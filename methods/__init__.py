@@ -6,20 +6,31 @@ A new method is one module defining a :class:`Detector` subclass plus one line i
 
 import inspect
 
-from .base import Detector, NotFittedError, Trace, fault_free_segments, run_detector
+from .base import (
+    Detector,
+    NotFittedError,
+    Trace,
+    fault_free_segments,
+    run_detector,
+    skipped_channels,
+)
+from .emulation_oracle import EmulationOracle
+from .end_of_flight import EndOfFlight
 from .ffrls_monitor import FfRlsMonitor
 from .glrt_residuals import GlrtResiduals
 from .kalman_okid import KalmanOkid
 from .rls_arx_zscore import RlsArxZscore
 
 __all__ = ["REGISTRY", "Detector", "NotFittedError", "Trace", "fault_free_segments",
-           "make_detector", "run_detector"]
+           "make_detector", "run_detector", "skipped_channels"]
 
 REGISTRY: dict[str, type[Detector]] = {
     "rls_arx_zscore": RlsArxZscore,
     "glrt_residuals": GlrtResiduals,
     "ffrls_monitor": FfRlsMonitor,
     "kalman_okid": KalmanOkid,
+    "emulation_oracle": EmulationOracle,
+    "end_of_flight": EndOfFlight,
 }
 
 

@@ -11,11 +11,18 @@ Simple models relate the commanded surface deflections to the body rates (eqs. 1
 Each is estimated online by RLS with forgetting factor :math:`\lambda_f` (eqs. 14-16;
 :class:`~.rls.RecursiveLeastSquares` computes the same recursion through the matrix
 inversion lemma). In ALFA the rates are the raw IMU's (``mavros-imu-data_raw``, ~10 Hz,
-every row a new measurement) and the deflections the servo outputs of
-``mavros-rc-out`` (~3 Hz, held between rows), as :math:`(\mathrm{PWM} - 1500)/500`,
-the servo's fixed range mapped onto [-1, 1]. The grid is the gyro's 10 Hz. Commanded
-against measured attitude (``nav_info``) would be the alternative, but its measured
-angle refreshes at only ~2.5 Hz and it relates angles, not the rates of the paper.
+every row a new measurement); the grid is the gyro's 10 Hz.
+
+The paper's deflections :math:`\delta` are the servo outputs of ``rc-out``. In ALFA
+those carry the fault emulation (the failed surface's channel goes flat at onset), so
+the primary run replaces them with what the autopilot turns into deflections: the
+attitude error (measured minus commanded, ``nav_info``) for roll and pitch, and the
+measured roll for yaw, the coordinated-turn relation :math:`r \approx g \tan\phi / V`
+linearised. This keeps the paper's structure (a rate against one driving signal, with
+:math:`r(k-1)` for yaw) on honest inputs. The servo form (:data:`SERVO_MODELS`) stays
+as the ``ffrls_monitor_servo`` run, ranked apart. Inputs are put on a common scale by
+unit: PWM as :math:`(\mathrm{PWM} - 1500)/500`, the servo's fixed range mapped onto
+[-1, 1]; degrees as radians.
 
 Two tests per model, both with thresholds read from fault-free data:
 
@@ -60,24 +67,48 @@ from collections import deque
 
 import numpy as np
 
-from alfa_bench.data import Sampled
+from alfa_bench.data import SIGNALS, Sampled
 
 from . import kernels
 from .base import Detector
 from .glrt import WindowedGlrt, empirical_threshold, glrt_statistic
 from .rls import RecursiveLeastSquares
 
-__all__ = ["DEFAULT_MODELS", "FfRlsMonitor", "joint_thresholds"]
+__all__ = ["DEFAULT_MODELS", "SERVO_MODELS", "FfRlsMonitor", "joint_thresholds",
+           "normalise_inputs"]
 
-#: eqs. (11)-(13): output rate, deflection inputs, and whether r(k-1) is a regressor
+#: eqs. (11)-(13) on honest inputs: output rate, driving signals, whether r(k-1) is a
+#: regressor
 DEFAULT_MODELS = (
-    {"name": "roll", "output": "roll_rate", "inputs": ["aileron_cmd"], "autoregressive": False},
-    {"name": "pitch", "output": "pitch_rate", "inputs": ["elevator_cmd"],
+    {"name": "roll", "output": "roll_rate", "inputs": ["roll_error"], "autoregressive": False},
+    {"name": "pitch", "output": "pitch_rate", "inputs": ["pitch_error"],
      "autoregressive": False},
-    {"name": "yaw", "output": "yaw_rate", "inputs": ["aileron_cmd"], "autoregressive": True},
+    {"name": "yaw", "output": "yaw_rate", "inputs": ["roll"], "autoregressive": True},
+)
+
+#: eqs. (11)-(13) as the paper states them, on the servo outputs (which carry ALFA's
+#: fault emulation)
+SERVO_MODELS = (
+    {"name": "roll", "output": "roll_rate", "inputs": ["servo_aileron_left"],
+     "autoregressive": False},
+    {"name": "pitch", "output": "pitch_rate", "inputs": ["servo_elevator"],
+     "autoregressive": False},
+    {"name": "yaw", "output": "yaw_rate", "inputs": ["servo_aileron_left"],
+     "autoregressive": True},
 )
 
 _PWM_CENTRE_US, _PWM_HALF_RANGE_US = 1500.0, 500.0
+
+
+def normalise_inputs(x: np.ndarray, names) -> np.ndarray:
+    """Columns ``x`` of signals ``names`` on a common scale: PWM (us) mapped from the
+    servo range onto [-1, 1], degrees to radians, other units as they are."""
+    units = np.array([SIGNALS[n].unit for n in names])
+    out = np.array(x, dtype=float, copy=True)
+    pwm, deg = units == "us", units == "deg"
+    out[..., pwm] = (out[..., pwm] - _PWM_CENTRE_US) / _PWM_HALF_RANGE_US
+    out[..., deg] = np.deg2rad(out[..., deg])
+    return out
 
 
 def joint_thresholds(g: np.ndarray, t: np.ndarray, false_alarm: float) -> tuple[float, float]:
@@ -107,6 +138,7 @@ class _Model:
     def __init__(self, det: FfRlsMonitor, spec: dict, cols: dict):
         self.y_col = cols[spec["output"]]
         self.u_cols = [cols[s] for s in spec["inputs"]]
+        self.u_names = list(spec["inputs"])
         self.ar = bool(spec["autoregressive"])
         self.n = len(self.u_cols) + self.ar + 1
         self.rls = RecursiveLeastSquares(self.n, det.p0, det.forgetting,
@@ -230,7 +262,7 @@ class FfRlsMonitor(Detector):
         """One model over ``s`` through :func:`~.kernels.ffrls_advance`: from the fitted
         prior (``from_prior``) or from theta = 0, P = p0 I; with or without freezing."""
         cols = {n: i for i, n in enumerate(s.names)}
-        u = (s.x[:, [cols[c] for c in spec["inputs"]]] - _PWM_CENTRE_US) / _PWM_HALF_RANGE_US
+        u = normalise_inputs(s.x[:, [cols[c] for c in spec["inputs"]]], spec["inputs"])
         y = np.ascontiguousarray(s.x[:, cols[spec["output"]]])
         n_par = len(spec["inputs"]) + bool(spec["autoregressive"]) + 1
         name = spec["name"]
@@ -289,7 +321,7 @@ class FfRlsMonitor(Detector):
         return self
 
     def _model_step(self, m: _Model, x: np.ndarray):
-        u = [(x[c] - _PWM_CENTRE_US) / _PWM_HALF_RANGE_US for c in m.u_cols]
+        u = list(normalise_inputs(x[m.u_cols], m.u_names))
         y = float(x[m.y_col])
         ar = [m.y_prev] if m.ar else []
         m.y_prev = y

@@ -6,14 +6,21 @@ from snakemake.exceptions import WorkflowError
 from alfa_bench.methods import make_detector
 
 METHODS = list(config["methods"])
+# the runs scored on the injected sensor faults and for isolation: the reference rows
+# speak of ALFA's metric and emulation, not of sensors
+DETECTORS = [m for m, spec in config["methods"].items()
+             if spec.get("role", "method") != "reference"]
 
 # the schema checks the config's shape; each method's detector and parameter names are
 # checked against the registry here, before any job runs
 for _name, _spec in config["methods"].items():
     try:
-        make_detector(_spec["detector"], _spec.get("params"))
+        _detector = make_detector(_spec["detector"], _spec.get("params"))
     except (KeyError, TypeError, ValueError) as _e:
         raise WorkflowError(f"config methods.{_name}: {_e}") from None
+    if not _detector.causal and _spec.get("role", "method") != "reference":
+        raise WorkflowError(f"config methods.{_name}: detector {_spec['detector']!r} is not "
+                            "causal, so it can only be a reference row (role: reference)")
 
 # ALFA_DIR, else the config's alfa_dir, else the downloaded archive.
 _alfa = os.environ.get("ALFA_DIR") or config.get("alfa_dir")
