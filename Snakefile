@@ -24,6 +24,8 @@ include: "rules/inject.smk"
 rule all:
     input:
         rules.tables.output,
+        rules.deadline.output,
+        rules.leakage.output,
         rules.runtime.output,
         rules.sweep.output,
         rules.figures.output,

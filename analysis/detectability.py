@@ -22,9 +22,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .figures import _colors, _save, plt
+from .figures import colors, plt, save
 from .scoring import flight_outcome
-from .tables import _fmt, _markdown
+from .tables import fmt, markdown
 
 __all__ = ["detectability_figure", "detectability_markdown", "detectability_table"]
 
@@ -95,15 +95,15 @@ def detectability_markdown(table: pd.DataFrame) -> str:
         cells = [_fault_name(kind, m)]
         for method in methods:
             r = idx.loc[(method, kind, m)]
-            cells.append(f"{_fmt(float(r['detection_rate']), True, 0)} "
-                         f"[{_fmt(float(r['chance_rate']), True, 0)}] "
-                         f"({_fmt(float(r['mean_detection_s']), digits=1)} s)")
+            cells.append(f"{fmt(float(r['detection_rate']), True, 0)} "
+                         f"[{fmt(float(r['chance_rate']), True, 0)}] "
+                         f"({fmt(float(r['mean_detection_s']), digits=1)} s)")
         rows.append(cells)
     per_sensor = table.groupby(["sensor", "method"], sort=False)[["detected", "flights"]].sum()
     rate = per_sensor["detected"] / per_sensor["flights"]
-    sensor_rows = [[s, *[_fmt(float(rate.loc[(s, m)]), True, 0) for m in methods]]
+    sensor_rows = [[s, *[fmt(float(rate.loc[(s, m)]), True, 0) for m in methods]]
                    for s in dict.fromkeys(table["sensor"])]
-    return _markdown([
+    return markdown([
         ("Detection rate % [chance rate %] (mean detection time) per injected fault, "
          "over all sensors",
          ["fault", *methods], rows),
@@ -115,7 +115,7 @@ def detectability_figure(table: pd.DataFrame, path: str | Path) -> None:
     faults without a size (stuck, zero) and those beyond the paper (noise, ramp)."""
     by = _by_fault(table)
     methods = list(dict.fromkeys(by["method"]))
-    colors = _colors(methods)
+    palette = colors(methods)
     fig, axes = plt.subplots(1, 3, figsize=(13, 3.8), layout="constrained")
     for ax, kind, size, label in [
             (axes[0], "drift", lambda m: m, "drift (fraction of the sensor's range)"),
@@ -125,8 +125,8 @@ def detectability_figure(table: pd.DataFrame, path: str | Path) -> None:
             x = size(d["magnitude"].to_numpy())
             order = np.argsort(x)
             ax.plot(x[order], d["detection_rate"].to_numpy()[order], "o-", label=method,
-                    color=colors[method])
-            ax.plot(x[order], d["chance_rate"].to_numpy()[order], ":", color=colors[method],
+                    color=palette[method])
+            ax.plot(x[order], d["chance_rate"].to_numpy()[order], ":", color=palette[method],
                     lw=1)
         ax.set_xlabel(label)
         ax.set_title(kind)
@@ -136,7 +136,7 @@ def detectability_figure(table: pd.DataFrame, path: str | Path) -> None:
     for i, method in enumerate(methods):
         d = by[by["method"] == method].set_index(["kind", "magnitude"])
         axes[2].bar(np.arange(len(other)) + i * width,
-                    [d.loc[f, "detection_rate"] for f in other], width, color=colors[method])
+                    [d.loc[f, "detection_rate"] for f in other], width, color=palette[method])
     axes[2].set_xticks(np.arange(len(other)) + 0.4 - width / 2,
                        [_fault_name(*f) for f in other], fontsize=8)
     axes[2].set_title("other faults")
@@ -146,4 +146,4 @@ def detectability_figure(table: pd.DataFrame, path: str | Path) -> None:
     axes[0].set_ylabel("detection rate (dotted: chance rate)")
     axes[0].legend(fontsize=7)
     fig.suptitle("Detectability of injected sensor faults (all sensors, onsets, flights)")
-    _save(fig, path)
+    save(fig, path)

@@ -26,18 +26,27 @@ from alfa_bench.methods import Trace  # noqa: E402
 from .sweep import ratio  # noqa: E402
 from .tables import FAULT_ORDER  # noqa: E402
 
-__all__ = ["detection_time_figure", "flight_figure", "sweep_figure"]
+__all__ = ["BLOCK_STYLES", "colors", "detection_time_figure", "flight_figure", "save",
+           "sweep_figure"]
 
 _DPI = 110
 _METADATA = {"Software": None}
 
 
-def _colors(methods) -> dict[str, tuple]:
-    cmap = plt.get_cmap("tab10")
-    return {m: cmap(i % 10) for i, m in enumerate(methods)}
+#: line styles of the blocks of runs (:func:`~.tables.block`): honest methods solid,
+#: those reading the emulation dashed, reference rows dotted
+BLOCK_STYLES = {"honest": {"ls": "-", "lw": 1.4}, "reads actuators": {"ls": "--", "lw": 1.1},
+                "reference": {"ls": ":", "lw": 1.1}}
 
 
-def _save(fig, path: str | Path) -> None:
+def colors(methods) -> dict[str, tuple]:
+    """A colour per method, in order (tab10, then every fourth of tab20b beyond ten)."""
+    cmap, more = plt.get_cmap("tab10"), plt.get_cmap("tab20b")
+    return {m: cmap(i) if i < 10 else more(4 * (i - 10) % 20) for i, m in enumerate(methods)}
+
+
+def save(fig, path: str | Path) -> None:
+    """Write ``fig`` as a deterministic PNG and close it."""
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=_DPI, metadata=_METADATA)
     plt.close(fig)
@@ -50,22 +59,24 @@ def sweep_figure(sweep: pd.DataFrame, subset: str, path: str | Path) -> None:
     before onset."""
     data = sweep[sweep["subset"] == subset]
     methods = list(dict.fromkeys(data["method"]))
-    colors = _colors(methods)
+    palette = colors(methods)
+    deadline = float(data["deadline_s"].iloc[0]) if len(data) else float("nan")
     fig, axes = plt.subplots(1, 3, figsize=(15, 5.0), layout="constrained")
     panels = [
         ("false_alarm_flights", "recall", "flights with a false alarm (share)",
-         "detection rate (recall)", "linear"),
+         f"detected within {deadline:g} s (recall)", "linear"),
         ("false_alarms_per_hour", "recall", "false alarms per hour of fault-free flight",
-         "detection rate (recall)", "symlog"),
+         f"detected within {deadline:g} s (recall)", "symlog"),
         ("false_alarms_per_hour", "mean_detection_s",
          "false alarms per hour of fault-free flight", "mean detection time (s)", "symlog"),
     ]
     for ax, (x, y, xlabel, ylabel, xscale) in zip(axes, panels, strict=True):
         for m in methods:
             d = data[data["method"] == m].sort_values("scale")
-            ax.plot(d[x], d[y], color=colors[m], lw=1.2, label=m, alpha=0.9)
+            ax.plot(d[x], d[y], color=palette[m], label=f"{m} ({d['block'].iloc[0]})",
+                    alpha=0.9, **BLOCK_STYLES[d["block"].iloc[0]])
             at = d[d["scale"] == 1.0]
-            ax.plot(at[x], at[y], "o", color=colors[m], ms=6, mec="black", mew=0.6)
+            ax.plot(at[x], at[y], "o", color=palette[m], ms=6, mec="black", mew=0.6)
         ax.set_xscale(xscale, **({"linthresh": 1.0} if xscale == "symlog" else {}))
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
@@ -74,11 +85,12 @@ def sweep_figure(sweep: pd.DataFrame, subset: str, path: str | Path) -> None:
     axes[0].set_ylim(-0.02, 1.02)
     axes[1].set_ylim(-0.02, 1.02)
     handles, labels = axes[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside lower center", ncol=len(methods), fontsize=9)
+    fig.legend(handles, labels, loc="outside lower center", ncol=min(4, len(methods)),
+               fontsize=8)
     n = int(data["flights"].iloc[0]) if len(data) else 0
     fig.suptitle(f"Threshold sweep, subset '{subset}' ({n} flights): every channel "
                  "threshold scaled by one factor; dots = configured thresholds")
-    _save(fig, path)
+    save(fig, path)
 
 
 def detection_time_figure(records: list[dict], flights: list[str], path: str | Path) -> None:
@@ -111,7 +123,7 @@ def detection_time_figure(records: list[dict], flights: list[str], path: str | P
     for ax in axes[:, 0]:
         ax.set_ylabel("detection time (s)")
     fig.suptitle("Detection time by fault class (bar = median; label = detected / flights)")
-    _save(fig, path)
+    save(fig, path)
 
 
 def flight_figure(flight: str, onset_s: float | None, end_s: float | None,
@@ -144,4 +156,4 @@ def flight_figure(flight: str, onset_s: float | None, end_s: float | None,
     axes[-1, 0].set_xlabel("flight time (s)")
     fig.suptitle(f"{flight}\nscore / threshold (dashed: alarm level; grey: fault; "
                  "red line: first alarm)", fontsize=9)
-    _save(fig, path)
+    save(fig, path)

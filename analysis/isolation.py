@@ -22,7 +22,7 @@ from alfa_bench.data import SIGNALS
 from alfa_bench.data.inject import SENSORS
 from alfa_bench.methods import Trace
 
-from .tables import _fmt, _markdown
+from .tables import fmt, markdown
 
 __all__ = ["MISSED", "SENSOR_ACTUATOR", "confusion", "isolate", "isolation_markdown",
            "isolation_rows", "measured_sensor"]
@@ -103,12 +103,12 @@ def isolation_markdown(rows: pd.DataFrame, truth: str) -> str:
     for method, table in confusion(rows, labels).items():
         g = rows[rows["method"] == method]
         responded = g[g["predicted"] != MISSED]
-        share = _fmt(float(g["correct"].mean()), True, 0)
-        of_responded = _fmt(float(responded["correct"].mean()) if len(responded) else None,
+        share = fmt(float(g["correct"].mean()), True, 0)
+        of_responded = fmt(float(responded["correct"].mean()) if len(responded) else None,
                             True, 0)
         body = [[true, *map(str, counts)] for true, counts in zip(
             table.index, table.to_numpy().tolist(), strict=True)]
         sections.append((f"`{method}`: isolated correctly {share} % of {len(g)} faults, "
                          f"{of_responded} % of the {len(responded)} it responded to",
                          ["true \\ isolated", *table.columns], body))
-    return _markdown(sections)
+    return markdown(sections)

@@ -7,13 +7,19 @@ included from the files the workflow writes (``\\input``/``{{file:path}}``). An
 unknown key or a missing file is an error, so the text cannot quote a number the
 run did not produce.
 
-Keys (``<m>`` a method run, ``<s>`` a subset): ``flights:<s>``, ``faultfree:<s>``,
-``precision:<m>:<s>``, ``recall:<m>:<s>``, ``accuracy:<m>:<s>`` (in %),
-``meandet:<m>:<s>``, ``maxdet:<m>:<s>`` (s), ``falsealarms:<m>:<s>`` ("k of n"),
-``best:<s>`` and ``bestaccuracy:<s>`` (the most accurate run), ``recallnofa:<m>:<s>``
-(the best recall of the threshold sweep with no false alarm on any flight, %),
-``paper:precision``, ``paper:recall``, ``paper:accuracy``, ``paper:meandet``,
-``paper:maxdet`` (Keipour et al. 2019, quoted).
+Keys (``<m>`` a method run, ``<s>`` a subset, ``<sig>`` a catalogue signal, ``<c>`` a
+fault class): ``deadline`` (s), ``flights:<s>``, ``faultfree:<s>``, ``faultflights:<s>``;
+scored with the deadline: ``precision:<m>:<s>``, ``recall:<m>:<s>``,
+``accuracy:<m>:<s>`` (in %), ``detected:<m>:<s>`` (faults detected in time),
+``meandet:<m>:<s>``, ``maxdet:<m>:<s>`` (s); by the paper's rule:
+``accuracypaper:<m>:<s>``, ``recallpaper:<m>:<s>`` (%); ``falsealarms:<m>:<s>`` ("k of
+n" fault-free flights), ``best:<s>`` and ``bestaccuracy:<s>`` (the best honest method),
+``tied:<s>`` (the runs the exact McNemar test cannot tell apart from it),
+``recallnofa:<m>:<s>`` (the best recall of the threshold sweep with no false alarm on
+any flight, %), ``leak:<sig>:<c>`` ("k of n" flights on which the signal goes flat at
+onset) and ``leakchance:<sig>:<c>`` (its larger chance rate, %), ``paper:precision``,
+``paper:recall``, ``paper:accuracy``, ``paper:meandet``, ``paper:maxdet`` (Keipour et
+al. 2019, quoted).
 """
 
 from __future__ import annotations
@@ -22,10 +28,13 @@ import math
 import re
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
+from alfa_bench.data import SIGNALS
+
 from .reference import ICRA2019_SUMMARY
-from .tables import latex_escape
+from .tables import FAULT_ORDER, latex_escape
 
 __all__ = ["latex_macros", "latex_keys", "paper_numbers", "render_markdown"]
 
@@ -43,7 +52,8 @@ def _sec(v: float) -> str:
     return "n/a" if math.isnan(v) else f"{v:.2f}"
 
 
-def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame) -> dict[str, str]:
+def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame,
+                  leakage: pd.DataFrame) -> dict[str, str]:
     """Every quotable number, as text, by key (see the module docstring)."""
     out = {f"paper:{k}": (_pct if k in ("precision", "recall", "accuracy") else _sec)(
         ICRA2019_SUMMARY[key])
@@ -52,21 +62,37 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame) -> dict[str, st
                        ("maxdet", "max_detection_s"))}
     for r in comparison.to_dict(orient="records"):
         m, s = r["method"], r["subset"]
+        out["deadline"] = f"{r['deadline_s']:g}"
         out[f"flights:{s}"] = str(r["flights"])
         out[f"faultfree:{s}"] = str(r["fault_free_flights"])
+        # every fault flight is a TP or a FN (an alarm before onset counts as both FP and FN)
+        out[f"faultflights:{s}"] = str(r["tp"] + r["fn"])
         for key in ("precision", "recall", "accuracy"):
             out[f"{key}:{m}:{s}"] = _pct(r[key])
+        out[f"accuracypaper:{m}:{s}"] = _pct(r["accuracy_paper"])
+        out[f"recallpaper:{m}:{s}"] = _pct(r["recall_paper"])
+        out[f"detected:{m}:{s}"] = f"{r['tp']} of {r['tp'] + r['fn']}"
         out[f"meandet:{m}:{s}"] = _sec(r["mean_detection_s"])
         out[f"maxdet:{m}:{s}"] = _sec(r["max_detection_s"])
         out[f"falsealarms:{m}:{s}"] = (f"{r['fault_free_false_alarms']} of "
                                        f"{r['fault_free_flights']}")
     for s, table in comparison.groupby("subset", sort=False):
-        best = table.sort_values(["accuracy", "method"], ascending=[False, True]).iloc[0]
-        out[f"best:{s}"] = best["method"]
-        out[f"bestaccuracy:{s}"] = _pct(best["accuracy"])
+        best = table[table["rank"] == 1]
+        out[f"best:{s}"] = best["method"].iloc[0] if len(best) else "none"
+        out[f"bestaccuracy:{s}"] = _pct(best["accuracy"].iloc[0]) if len(best) else "n/a"
+        tied = table[(table["vs_best_p"] >= 0.05) & (table["block"] == "honest")]
+        out[f"tied:{s}"] = ", ".join(tied["method"]) or "none"
     for (m, s), table in sweep.groupby(["method", "subset"], sort=False):
         clean = table[table["fp"] == 0]
         out[f"recallnofa:{m}:{s}"] = _pct(clean["recall"].max()) if len(clean) else "n/a"
+    # every signal and fault class, so that a flight set without some class still renders
+    out |= {f"{k}:{sig}:{c}": "n/a" for k in ("leak", "leakchance") for sig in SIGNALS
+            for c in FAULT_ORDER if c != "none"}
+    for r in leakage.to_dict(orient="records"):
+        key = f"{r['signal']}:{r['fault_class']}"
+        out[f"leak:{key}"] = f"{r['flat_at_onset']} of {r['flights']}"
+        out[f"leakchance:{key}"] = _pct(float(np.nanmax([r["chance_before_onset"],
+                                                          r["chance_fault_free"]])))
     return out
 
 

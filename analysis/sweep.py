@@ -11,9 +11,10 @@ monotone and :math:`s > \\gamma \\Leftrightarrow s/\\gamma > 1`). A detector who
 state depends on its own threshold (``ffrls_monitor`` freezes adaptation while its
 residual test is up) is swept open-loop: its scores stay those of the configured run.
 
-Per scale, flights are scored as :mod:`.scoring` scores them, and false alarms are
-also counted as events (rising edges of the alarm) per hour of fault-free flight:
-whole fault-free flights and faulty flights before onset.
+Per scale, flights are scored as :mod:`.scoring` scores them, with the detection
+deadline (and the paper's rule beside it: ``recall_paper``, ``accuracy_paper``), and
+false alarms are also counted as events (rising edges of the alarm) per hour of
+fault-free flight: whole fault-free flights and faulty flights before onset.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from alfa_bench.data import subset_flights
 from alfa_bench.methods import Trace
 
 from .scoring import flight_outcome, summarize
+from .tables import block
 
 __all__ = ["DEFAULT_SCALES", "flight_curves", "ratio", "sweep_table"]
 
@@ -59,8 +61,10 @@ def flight_curves(trace: Trace, onset_s: float | None, scales: np.ndarray) -> di
 
 
 def sweep_table(records: list[dict], traces: dict[tuple[str, str], Trace],
-                manifest: pd.DataFrame, subsets, scales=DEFAULT_SCALES) -> pd.DataFrame:
-    """Per method, subset and scale: the scoring of :func:`~.scoring.summarize` plus
+                manifest: pd.DataFrame, subsets, deadline_s: float,
+                scales=DEFAULT_SCALES) -> pd.DataFrame:
+    """Per method, subset and scale: the scoring of :func:`~.scoring.summarize` under
+    ``deadline_s``, the paper's recall and accuracy (no deadline), plus
     ``false_alarm_flights`` (share of flights alarmed in fault-free flight) and
     ``false_alarms_per_hour``. ``traces`` maps (method, flight) to its trace."""
     scales = np.asarray(scales, dtype=float)
@@ -68,6 +72,7 @@ def sweep_table(records: list[dict], traces: dict[tuple[str, str], Trace],
                                                             r["onset_s"], scales))
               for r in records}
     methods = list(dict.fromkeys(r["method"] for r in records))
+    blocks = {r["method"]: block(r) for r in records}
     rows = []
     for subset in subsets:
         flights = subset_flights(manifest, subset)
@@ -77,16 +82,20 @@ def sweep_table(records: list[dict], traces: dict[tuple[str, str], Trace],
             hours = sum(c["free_s"] for _, c in cs) / 3600.0
             events = np.sum([c["events"] for _, c in cs], axis=0)
             for i, kappa in enumerate(scales):
-                outcomes, times = [], []
+                outcomes, times, paper = [], [], []
                 for rec, c in cs:
                     first = c["first_alarm_s"][i]
                     first = None if np.isnan(first) else float(first)
-                    outcome = flight_outcome(rec["onset_s"], first)
+                    outcome = flight_outcome(rec["onset_s"], first, deadline_s)
                     outcomes.append(outcome)
                     times.append(first - rec["onset_s"] if outcome == "TP" else None)
+                    paper.append(flight_outcome(rec["onset_s"], first))
                 s = summarize(outcomes, times)
+                p = summarize(paper)
                 rows.append({
-                    "method": method, "subset": subset, "scale": float(kappa), **s,
+                    "method": method, "subset": subset, "block": blocks[method],
+                    "deadline_s": deadline_s, "scale": float(kappa), **s,
+                    "recall_paper": p["recall"], "accuracy_paper": p["accuracy"],
                     "false_alarm_flights": (s["fp"] / s["flights"]) if s["flights"] else np.nan,
                     "false_alarms_per_hour": events[i] / hours if hours else np.nan,
                     "fault_free_hours": hours,

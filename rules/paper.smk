@@ -3,6 +3,8 @@ import shutil
 # The manuscript's inputs: every file it includes is written by the workflow.
 PAPER_INPUTS = [
     *rules.tables.output,
+    *rules.deadline.output,
+    *rules.leakage.output,
     "results/tables/sweep.csv",
     "results/figures/sweep.png",
     "results/figures/detection_time.png",
@@ -18,6 +20,7 @@ rule paper_sources:
         manifest="data/flights.csv",
         comparison="results/tables/comparison.csv",
         sweep="results/tables/sweep.csv",
+        leakage="results/tables/leakage.csv",
         tex=PAPER_DIR / "paper.tex",
         markdown=PAPER_DIR / "paper.template.md",
     output:

@@ -7,6 +7,7 @@ rule sweep:
         report("results/tables/sweep.csv", category="Threshold sweeps"),
     params:
         subsets=config["subsets"],
+        deadline_s=config["scoring"]["deadline_s"],
     log:
         "results/logs/sweep.log",
     script:

@@ -16,6 +16,7 @@ rule tables:
         comparison_tex="results/tables/comparison.tex",
     params:
         subsets=config["subsets"],
+        deadline_s=config["scoring"]["deadline_s"],
     log:
         "results/logs/tables.log",
     script:
@@ -34,3 +35,36 @@ rule runtime:
         "results/logs/runtime.log",
     script:
         "../scripts/runtime.py"
+
+
+rule deadline:
+    input:
+        manifest="data/flights.csv",
+        detections=expand("results/detections/{method}", method=METHODS),
+    output:
+        csv="results/tables/deadline.csv",
+        md=report("results/tables/deadline.md", category="Tables"),
+        figure=report("results/figures/deadline.png", caption="../report/deadline.rst",
+                      category="Detection times"),
+    params:
+        subsets=config["subsets"],
+        deadlines_s=config["scoring"]["deadlines_s"],
+        subset=config["figures"]["subset"],
+    log:
+        "results/logs/deadline.log",
+    script:
+        "../scripts/deadline.py"
+
+
+# which signals carry the fault emulation, measured on the flights themselves
+rule leakage:
+    input:
+        manifest="data/flights.csv",
+        processed=PROCESSED,
+    output:
+        csv="results/tables/leakage.csv",
+        md=report("results/tables/leakage.md", category="Tables"),
+    log:
+        "results/logs/leakage.log",
+    script:
+        "../scripts/leakage.py"

@@ -9,7 +9,8 @@ from alfa_bench.data import read_manifest
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
-numbers = paper_numbers(read_table(sm.input.comparison), read_table(sm.input.sweep))
+numbers = paper_numbers(read_table(sm.input.comparison), read_table(sm.input.sweep),
+                        read_table(sm.input.leakage))
 unknown = latex_keys(Path(sm.input.tex).read_text()) - set(numbers)
 if unknown:
     raise KeyError(f"{sm.input.tex} quotes results no run defines: {sorted(unknown)}")

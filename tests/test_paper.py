@@ -16,13 +16,24 @@ MARKDOWN = re.sub(r"<!--.*?-->", "", (REPO / "paper/paper.template.md").read_tex
 
 
 def comparison(**overrides):
-    row = {"subset": "all", "method": "a", "detector": "d", "calibration": "none",
-           "flights": 10, "precision": 0.5, "recall": 0.25, "accuracy": 0.4,
-           "mean_detection_s": 1.5, "max_detection_s": float("nan"),
+    row = {"subset": "all", "method": "a", "block": "honest", "rank": 2, "detector": "d",
+           "calibration": "none", "deadline_s": 5.0, "flights": 10, "tp": 2, "fp": 2,
+           "fn": 5, "tn": 2, "precision": 0.5, "recall": 0.25, "accuracy": 0.4,
+           "mean_detection_s": 1.5, "max_detection_s": float("nan"), "accuracy_paper": 0.7,
+           "recall_paper": 0.8, "mean_detection_s_paper": 6.0,
            "fault_free_flights": 3, "fault_free_false_alarms": 1, "armed_flights": 10,
-           "excluded": 1}
-    rows = [row, {**row, "method": "b", "accuracy": 0.6}]
+           "excluded": 1, "vs_best_only_this": 0, "vs_best_only_best": 2, "vs_best_p": 0.5}
+    rows = [row, {**row, "method": "b", "accuracy": 0.6, "rank": 1, "vs_best_p": float("nan")},
+            {**row, "method": "c", "accuracy": 0.9, "block": "reads actuators",
+             "rank": float("nan"), "vs_best_p": 0.01}]
     return pd.DataFrame([{**r, **overrides} for r in rows])
+
+
+def leakage():
+    return pd.DataFrame({"signal": ["servo_throttle", "roll"], "fault_class": ["engine"] * 2,
+                         "flights": [20, 20], "flat_at_onset": [20, 0],
+                         "chance_before_onset": [0.1, float("nan")],
+                         "chance_fault_free": [0.15, 0.0]})
 
 
 def sweep():
@@ -31,9 +42,16 @@ def sweep():
 
 
 def test_numbers_come_from_the_tables():
-    n = paper_numbers(comparison(), sweep())
+    n = paper_numbers(comparison(), sweep(), leakage())
     assert n["accuracy:a:all"] == "40.00" and n["maxdet:a:all"] == "n/a"
+    # the best is the top honest method, never a marked one, however accurate
     assert n["best:all"] == "b" and n["bestaccuracy:all"] == "60.00"
+    assert n["tied:all"] == "a" and n["accuracypaper:a:all"] == "70.00"
+    assert n["detected:a:all"] == "2 of 7" and n["deadline"] == "5"
+    assert n["leak:servo_throttle:engine"] == "20 of 20"
+    assert n["leakchance:servo_throttle:engine"] == "15.00"
+    assert n["leakchance:roll:engine"] == "0.00"
+    assert n["leak:servo_elevator:elevator"] == "n/a"    # no elevator flight here
     assert n["falsealarms:a:all"] == "1 of 3"
     assert n["recallnofa:a:all"] == "10.00" and n["recallnofa:b:all"] == "n/a"
     assert n["paper:accuracy"] == "86.36"
@@ -76,12 +94,19 @@ def test_every_quoted_key_is_one_the_numbers_define():
             for m in config["methods"] for s in config["subsets"]]
     sweeps = pd.DataFrame([{"method": m, "subset": s, "fp": 0, "recall": 0.0}
                            for m in config["methods"] for s in config["subsets"]])
-    assert latex_keys(TEX) <= set(paper_numbers(pd.DataFrame(rows), sweeps))
+    # every catalogue signal and fault class, as the leakage audit writes them
+    from alfa_bench.analysis.tables import FAULT_ORDER
+    from alfa_bench.data import SIGNALS
+    leak = pd.DataFrame([{**leakage().iloc[0].to_dict(), "signal": sig, "fault_class": c}
+                         for sig in SIGNALS for c in FAULT_ORDER if c != "none"])
+    assert latex_keys(TEX) <= set(paper_numbers(pd.DataFrame(rows), sweeps, leak))
 
 
 def test_latex_tables_escape_and_label():
     tex = comparison_latex(comparison())
     assert r"\label{tab:comparison-1}" in tex and r"\texttt{all}" in tex
     assert "\\toprule" in tex and tex.count(r"\begin{table}") == 1
-    assert " & 50.00 & 25.00 & 40.00 & 1.50 & - & 1 of 3 & 10 & 1 \\\\" in tex
-    assert "(11 flights)" in tex
+    assert (" & 50.0 & 25.0 & 40.0 & 1.50 & - & 70.00 & 6.00 & 1 of 3 & 0 / 2, p = 0.500 "
+            "(cannot tell apart) & 10 & 1 \\\\") in tex
+    assert "MARKED: reads what the fault emulation writes" in tex
+    assert "(11 flights; deadline 5.0 s)" in tex

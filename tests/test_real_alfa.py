@@ -63,3 +63,27 @@ def test_calibrated_detectors_fit_and_run_on_real_flights(name, manifest, real_p
     trace = run_detector(det, load_flight(real_processed / scored))
     assert np.isfinite(trace.score).any(axis=0).all()     # every channel arms
     json.dumps(det.fitted(), allow_nan=False)             # finite, JSON-ready
+
+
+def test_the_leakage_audit_finds_the_emulation_and_no_sensor(manifest, real_processed):
+    """On ALFA itself: the failed actuator's output goes flat at onset, measured, on its
+    own fault class; no attitude, gyro or setpoint signal does."""
+    from alfa_bench.analysis.leakage import leakage_table
+    flights = {n: load_flight(real_processed / n)
+               for n in manifest.loc[manifest["ground_truth"], "flight"]}
+    table = leakage_table(flights)
+    leaks = set(map(tuple, table.loc[table["leaks"], ["signal", "fault_class"]].to_numpy()))
+    expected = {("servo_throttle", "engine"), ("throttle", "engine")}
+    classes = set(table["fault_class"])
+    expected |= {("servo_rudder", "rudder")} if "rudder" in classes else set()
+    expected |= {("servo_elevator", "elevator")} if "elevator" in classes else set()
+    assert expected <= leaks
+    assert not set(table.loc[table["leaks"], "kind"]) - {"actuator"}
+    for sensor in ("roll", "pitch", "roll_rate", "pitch_rate", "yaw_rate"):
+        assert not table.loc[table["signal"] == sensor, "leaks"].any(), sensor
+
+
+def test_measured_airspeed_is_not_measured_from_2018_09_11_on(manifest):
+    dead = manifest["not_measured"].str.split(";").apply(lambda s: "airspeed" in s)
+    assert (dead == (manifest["date"] >= "2018-09-11")
+            | (manifest["label"] == "no_ground_truth")).all()

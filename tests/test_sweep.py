@@ -1,5 +1,7 @@
 """Threshold sweeps from stored scores."""
 
+import math
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -63,7 +65,7 @@ def test_sweep_table_scores_like_the_records_at_scale_one():
                         "outcome": flight_outcome(onset[f[1]], first)})
     manifest = pd.DataFrame({"flight": list(onset), "subsets": ["all"] * 3,
                              "ground_truth": [True] * 3})
-    table = sweep_table(records, traces, manifest, ["all"], DEFAULT_SCALES)
+    table = sweep_table(records, traces, manifest, ["all"], math.inf, DEFAULT_SCALES)
     at_one = table[table["scale"] == 1.0].iloc[0]
     assert (at_one["tp"], at_one["fp"], at_one["fn"], at_one["tn"]) == (1, 2, 1, 0)
     # f2 alarms at 2.0 s (before onset) and f3 (fault-free) at 6.0 s: 2 events in

@@ -54,9 +54,12 @@ def test_outputs_and_their_contents(runs, corpus):
     config = yaml.safe_load((REPO / "config/config.yaml").read_text())
     summary = read_table(out / "tables/summary.csv")
     assert set(summary["method"]) == set(config["methods"])
-    assert list(summary.columns) == [
-        "method", "subset", "flights", "tp", "fp", "fn", "tn", "precision", "recall",
-        "accuracy", "mean_detection_s", "max_detection_s", "excluded"]
+    scores = ["tp", "fp", "fn", "tn", "precision", "recall", "accuracy", "mean_detection_s",
+              "max_detection_s"]
+    assert list(summary.columns[:5]) == ["method", "subset", "block", "deadline_s", "flights"]
+    assert {*scores, *(f"{c}_paper" for c in scores), "precision_low", "accuracy_high",
+            "excluded"} <= set(summary.columns)
+    assert (summary["deadline_s"] == config["scoring"]["deadline_s"]).all()
     assert (summary["excluded"] == 0).all()
     assert read_table(out / "tables/failures.csv").empty
     assert set(summary["subset"]) == set(config["subsets"])
@@ -67,14 +70,26 @@ def test_outputs_and_their_contents(runs, corpus):
         assert [p.stem for p in records] == sorted(p.name for p in corpus.iterdir())
         r = json.loads(records[0].read_text())
         assert {"flight", "method", "parameters", "onset_s", "first_alarm_s", "alarm_intervals",
-                "pair_first_alarm_s", "pair_armed_s", "outcome", "provenance"} <= set(r)
+                "pair_first_alarm_s", "pair_armed_s", "outcome", "provenance", "role",
+                "reads_actuators", "signal_kinds", "skipped_channels"} <= set(r)
         assert r["provenance"]["inputs"]["flight_sha256"]
     assert "Keipour et al. ICRA 2019 (paper)" in (out / "tables/summary.md").read_text()
     comparison = read_table(out / "tables/comparison.csv")
     assert set(comparison["method"]) == set(config["methods"])
     calibrated = comparison[comparison["calibration"] != "none"]
-    assert set(calibrated["detector"]) == {"glrt_residuals", "ffrls_monitor", "kalman_okid"}
+    assert set(calibrated["detector"]) == {"glrt_residuals", "ffrls_monitor", "kalman_okid",
+                                           "emulation_oracle"}
     assert "Keipour et al. ICRA 2019 (paper)" in (out / "tables/comparison.md").read_text()
+    block = dict(zip(comparison["method"], comparison["block"], strict=False))
+    assert block["end_of_flight"] == block["emulation_oracle"] == "reference"
+    assert block["ffrls_monitor_servo"] == block["okid_bank_servo"] == "reads actuators"
+    assert block["ffrls_monitor"] == block["rls_arx_zscore"] == "honest"
+    for subset, table in comparison.groupby("subset"):   # only honest methods are ranked
+        ranked = table.dropna(subset=["rank"])
+        assert set(ranked["block"]) == {"honest"}, subset
+        assert sorted(ranked["rank"]) == list(range(1, len(ranked) + 1))
+        assert list(table["block"]) == sorted(table["block"], key=["honest", "reads actuators",
+                                                                   "reference"].index)
     assert (runs[0] / "data/flights.csv").exists()
 
 
@@ -117,14 +132,16 @@ def test_the_injected_grid_is_scored_and_isolated(runs, corpus):
         grid["onsets"])
     assert set(injected["fault_sensor"]) == set(sensors)
     assert set(injected["fault_class"]) == {"sensor"}
+    detectors = [m for m, spec in config["methods"].items() if spec.get("role") != "reference"]
     table = read_table(out / "tables/detectability.csv")
-    assert set(table["method"]) == set(config["methods"])
+    assert set(table["method"]) == set(detectors)
     assert (table.groupby("method")["flights"].sum() == len(injected)).all()
     assert ((table["detected"] + table["alarmed_before_onset"] + table["missed"])
             == table["flights"]).all()
     assert table["chance_rate"].between(0, 1).all()
     sensors_iso = read_table(out / "tables/isolation_sensors.csv")
-    assert len(sensors_iso) == len(injected) * len(config["methods"])
+    assert len(sensors_iso) == len(injected) * len(detectors)
+    assert read_table(out / "injected/skipped.csv").empty   # every sensor is live here
     actuators = read_table(out / "tables/isolation_actuators.csv")
     assert set(actuators["true"]) == {"engine", "rudder", "aileron"}
     assert "true \\ isolated" in (out / "tables/isolation_actuators.md").read_text()
@@ -142,6 +159,27 @@ def test_the_html_report_holds_the_figures_and_tables(runs, corpus):
     html = (work / "report.html").read_text()
     for name in ("sweep.png", "detection_time.png", "comparison.csv", "paper.md"):
         assert name in html, name
+
+
+def test_the_honest_benchmark_outputs(runs):
+    """The leakage audit, the deadline curve and the reference rows, on the corpus."""
+    out = runs[0] / "results"
+    leak = read_table(out / "tables/leakage.csv")
+    leaking = set(map(tuple, leak.loc[leak["leaks"], ["signal", "fault_class"]].to_numpy()))
+    assert {("servo_throttle", "engine"), ("throttle", "engine"),
+            ("servo_rudder", "rudder")} <= leaking
+    assert not set(leak.loc[leak["leaks"], "kind"]) - {"actuator"}
+    assert "Which signals carry the fault emulation" in (out / "tables/leakage.md").read_text()
+    deadline = read_table(out / "tables/deadline.csv")
+    for _, g in deadline.groupby(["method", "subset"]):
+        assert g.sort_values("deadline_s")["detected"].is_monotonic_increasing
+    assert (out / "figures/deadline.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    summary = read_table(out / "tables/summary.csv").set_index(["method", "subset"])
+    end = summary.loc[("end_of_flight", "all")]
+    # lateness alone: every fault flight "detected" by the paper's rule, none in time
+    assert (end["tp"], end["tp_paper"], end["fn_paper"]) == (0, 4, 0)
+    oracle = summary.loc[("emulation_oracle", "all")]
+    assert oracle["tp"] >= 2      # the engine flights: throttle flat at onset
 
 
 def test_synthetic_faults_are_found(runs):

@@ -1,0 +1,20 @@
+"""Snakemake script: the leakage audit of every catalogue signal over the flights."""
+
+from pathlib import Path
+
+from alfa_bench.analysis.leakage import leakage_markdown, leakage_table
+from alfa_bench.analysis.logs import log_to
+from alfa_bench.analysis.provenance import run_provenance, stamp
+from alfa_bench.data import load_flight, read_manifest
+
+sm = snakemake  # noqa: F821
+log_to(sm.log[0])
+manifest = read_manifest(sm.input.manifest)
+flights = {name: load_flight(Path(sm.input.processed) / name)
+           for name in manifest.loc[manifest["ground_truth"], "flight"]}
+table = leakage_table(flights)
+table.to_csv(sm.output.csv, index=False)
+Path(sm.output.md).write_text(leakage_markdown(table))
+prov = run_provenance(sm.config, manifest)
+for path in sm.output:
+    stamp(path, prov)

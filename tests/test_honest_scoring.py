@@ -1,0 +1,95 @@
+"""The deadline, the intervals and the paired test of the honest benchmark."""
+
+import math
+
+import pytest
+from scipy.stats import binomtest
+
+from alfa_bench.analysis.scoring import (
+    flight_outcome,
+    mcnemar_exact,
+    score_records,
+    summarize,
+    wilson_interval,
+)
+from alfa_bench.analysis.tables import block, comparison_table
+from alfa_bench.data import read_manifest
+
+
+def test_a_first_alarm_after_the_deadline_is_a_miss():
+    assert flight_outcome(10.0, 14.9, deadline_s=5.0) == "TP"
+    assert flight_outcome(10.0, 15.0, deadline_s=5.0) == "TP"
+    assert flight_outcome(10.0, 15.1, deadline_s=5.0) == "FN"
+    assert flight_outcome(10.0, 99.0) == "TP"              # the paper's rule
+    assert flight_outcome(10.0, 9.0, deadline_s=5.0) == "FP+FN"
+    assert flight_outcome(None, 1.0, deadline_s=5.0) == "FP"
+
+
+def test_end_of_flight_scores_well_without_a_deadline_and_nothing_with_one():
+    records = [{"onset_s": 50.0, "first_alarm_s": 66.0}] * 7 + [
+        {"onset_s": None, "first_alarm_s": 80.0}] * 2
+    _, late = score_records(records)
+    _, timely = score_records(records, deadline_s=5.0)
+    assert late["accuracy"] == pytest.approx(7 / 9) and late["mean_detection_s"] == 16.0
+    assert timely["tp"] == 0 and timely["accuracy"] == 0.0
+
+
+def test_wilson_interval_matches_scipy_and_holds_the_rate():
+    low, high = wilson_interval(15, 17)
+    ci = binomtest(15, 17).proportion_ci(method="wilson")
+    assert (low, high) == pytest.approx((ci.low, ci.high))
+    assert low < 15 / 17 < high
+    assert all(math.isnan(v) for v in wilson_interval(0, 0))
+    s = summarize(["TP", "TP", "FN", "TN"])
+    assert s["recall_low"] < s["recall"] < s["recall_high"]
+
+
+def test_mcnemar_counts_only_the_discordant_flights():
+    a = [True] * 10 + [True] * 6 + [False] * 4
+    b = [True] * 10 + [False] * 6 + [False] * 4
+    test = mcnemar_exact(a, b)
+    assert (test["only_a"], test["only_b"]) == (6, 0)
+    assert test["p_value"] == pytest.approx(2 * 0.5 ** 6)
+    assert mcnemar_exact([True, False], [True, False])["p_value"] == 1.0
+    with pytest.raises(ValueError, match="same flights"):
+        mcnemar_exact([True], [True, False])
+
+
+def test_blocks_follow_the_role_and_the_inputs():
+    assert block({"role": "reference", "reads_actuators": True}) == "reference"
+    assert block({"role": "method", "reads_actuators": True}) == "reads actuators"
+    assert block({"role": "method", "reads_actuators": False}) == "honest"
+
+
+def _record(method, flight, onset, first, actuators=False, role="method"):
+    return {"method": method, "flight": flight, "onset_s": onset, "first_alarm_s": first,
+            "fault_class": "none" if onset is None else "engine", "detector": method,
+            "reads_actuators": actuators, "role": role, "calibration": None,
+            "pair_armed_s": {"c": 0.0}}
+
+
+def test_a_marked_method_is_never_ranked_however_accurate(corpus):
+    from alfa_bench.data import build_manifest
+    manifest = build_manifest(corpus)
+    flights = manifest.loc[manifest["ground_truth"]]
+    records = []
+    for r in flights.itertuples():
+        onset = None if math.isnan(r.onset_s) else r.onset_s
+        perfect = None if onset is None else onset + 0.5
+        records += [_record("servo_reader", r.flight, onset, perfect, actuators=True),
+                    _record("slow", r.flight, onset, None if onset is None else onset + 9),
+                    _record("early", r.flight, onset, 1.0)]
+    table = comparison_table(records, manifest, ["all"], deadline_s=5.0)
+    table = table.set_index("method")
+    assert table.loc["servo_reader", "accuracy"] == 1.0
+    assert math.isnan(table.loc["servo_reader", "rank"])
+    assert table.loc["slow", "rank"] == 1 and table.loc["early", "rank"] == 2
+    assert table.loc["slow", "accuracy_paper"] > table.loc["slow", "accuracy"]
+    assert list(table.index) == ["slow", "early", "servo_reader"]
+
+
+def test_the_manifest_reads_back_its_not_measured_column(corpus, tmp_path):
+    from alfa_bench.data import build_manifest
+    manifest = build_manifest(corpus)
+    manifest.to_csv(tmp_path / "m.csv", index=False)
+    assert list(read_manifest(tmp_path / "m.csv")["not_measured"]) == [""] * len(manifest)
