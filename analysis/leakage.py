@@ -69,7 +69,6 @@ def leakage_table(flights: dict[str, Flight], flat_s: float = 1.0, before_s: flo
     """
     width = before_s + after_s
     labelled = {n: f for n, f in flights.items() if f.fault is not None}
-    free_hits = {}
     rows = []
     for name, sig in SIGNALS.items():
         per_class: dict[str, list] = {}
@@ -95,20 +94,20 @@ def leakage_table(flights: dict[str, Flight], flat_s: float = 1.0, before_s: flo
             at = bool(np.any((starts >= onset - before_s) & (starts <= onset + after_s)))
             entry.append((at, *_window_share(starts, float(t[0]), onset - margin_s, width,
                                              step_s)))
-        free_hits[name] = hits / windows if windows else math.nan
+        chance_free = hits / windows if windows else math.nan
         for fault_class in [c for c in FAULT_ORDER if c in per_class and c != "none"]:
             entries = per_class[fault_class]
             live = [e for e in entries if e is not None]
             n, k = len(live), sum(e[0] for e in live)
             before = sum(e[2] for e in live)
             chance_before = sum(e[1] for e in live) / before if before else math.nan
-            p0 = np.nanmax([chance_before, free_hits[name], 0.0])
+            p0 = np.nanmax([chance_before, chance_free, 0.0])
             p = float(binom.sf(k - 1, n, p0)) if n else math.nan
             rows.append({
                 "signal": name, "kind": sig.kind, "fault_class": fault_class, "flights": n,
                 "not_measured": len(entries) - n, "flat_at_onset": k,
                 "share_at_onset": k / n if n else math.nan,
-                "chance_before_onset": chance_before, "chance_fault_free": free_hits[name],
+                "chance_before_onset": chance_before, "chance_fault_free": chance_free,
                 "p_value": p, "leaks": bool(n and k / n >= 0.5 and p < alpha),
             })
     return pd.DataFrame(rows)
