@@ -7,8 +7,9 @@ with the highest score-to-threshold ratio names the measured signal it scores
 (:meth:`~alfa_bench.methods.Detector.channel_outputs`), which names a sensor
 (:func:`measured_sensor`). For ALFA's actuator faults, the sensor names the control
 axis it measures and so the actuator class that acts on that axis first
-(:data:`SENSOR_ACTUATOR`): roll → aileron, pitch → elevator, yaw → rudder, airspeed →
-engine. A flight with no alarm from the onset on is ``missed``. Isolation is judged
+(:data:`SENSOR_ACTUATOR`): roll → aileron, pitch → elevator, yaw and lateral specific
+force → rudder, airspeed and longitudinal specific force → engine. A flight with no
+alarm from the onset on is ``missed``. Isolation is judged
 on the response to the fault alone: a false alarm before the onset is counted by the
 detection scores, not here.
 """
@@ -32,18 +33,22 @@ _ACTUATORS = ["engine", "aileron", "elevator", "rudder"]
 MISSED = "missed"
 SENSOR_ACTUATOR = {"roll": "aileron", "roll_rate": "aileron", "pitch": "elevator",
                    "pitch_rate": "elevator", "yaw": "rudder", "yaw_rate": "rudder",
-                   "airspeed": "engine"}
+                   "airspeed": "engine", "accel_x": "engine", "accel_y": "rudder"}
 
 
 def measured_sensor(signal: str) -> str:
-    """The sensor (a name of :data:`~alfa_bench.data.inject.SENSORS`) whose readings
-    ``signal`` is made of: ``roll_error`` is the roll sensor's reading minus a command."""
+    """The sensor whose readings ``signal`` is made of: ``roll_error`` is the roll
+    sensor's reading minus a command. A name of :data:`~alfa_bench.data.inject.SENSORS`
+    (the sensors faults are injected into), else the sensor signal itself (the specific
+    force ``accel_x``)."""
     sig = SIGNALS[signal]
     for name in SENSORS:
         s = SIGNALS[name]
         if (s.topic, s.column) == (sig.topic, sig.column):
             return name
-    raise KeyError(f"signal {signal!r} reads no sensor of {SENSORS}")
+    if sig.kind == "sensor":
+        return signal
+    raise KeyError(f"signal {signal!r} reads no sensor")
 
 
 def isolate(trace: Trace, onset_s: float, outputs: dict[str, str]) -> str:

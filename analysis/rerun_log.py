@@ -44,7 +44,8 @@ __all__ = ["TIMELINE", "blueprint", "read_rerun_provenance", "signal_group", "wr
 
 TIMELINE = "flight_time"
 _APPLICATION = "alfa-bench"
-_GROUPS = ("attitude", "attitude_error", "rates", "servos", "airspeed")
+_GROUPS = ("attitude", "attitude_error", "rates", "specific_force", "servos", "airspeed",
+           "altitude")
 _RED = (220, 40, 40)
 
 
@@ -55,7 +56,8 @@ def signal_group(name: str) -> str:
         return "servos"      # the outputs the fault emulation writes, throttle included
     if sig.unit == "deg":
         return "attitude_error" if sig.minus else "attitude"
-    return {"rad/s": "rates", "m/s": "airspeed"}[sig.unit]
+    return {"rad/s": "rates", "m/s^2": "specific_force", "m/s": "airspeed",
+            "m": "altitude"}[sig.unit]
 
 
 def blueprint(methods: list[str], groups: list[str]) -> rrb.Blueprint:

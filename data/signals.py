@@ -91,6 +91,9 @@ SIGNALS: dict[str, Signal] = {
     "airspeed_cmd": Signal("mavros-nav_info-airspeed", "field.commanded", "setpoint",
                            unit="m/s"),
     "airspeed": Signal("mavros-nav_info-airspeed", "field.measured", "sensor", unit="m/s"),
+    # the autopilot's own altitude error (target minus measured): the energy its
+    # throttle is asked to make up
+    "altitude_error": Signal("mavros-nav_info-errors", "field.alt_error", "setpoint", unit="m"),
     # body rates from the raw IMU, the freshest sensor in ALFA (~10 Hz, every row new)
     "roll_rate": Signal("mavros-imu-data_raw", "field.angular_velocity.x", "sensor",
                         unit="rad/s"),
@@ -98,6 +101,12 @@ SIGNALS: dict[str, Signal] = {
                          unit="rad/s"),
     "yaw_rate": Signal("mavros-imu-data_raw", "field.angular_velocity.z", "sensor",
                        unit="rad/s"),
+    # specific force in body axes from the same IMU rows: thrust minus drag along x,
+    # sideslip along y (gravity included: x reads g sin(pitch) in steady flight)
+    "accel_x": Signal("mavros-imu-data_raw", "field.linear_acceleration.x", "sensor",
+                      unit="m/s^2"),
+    "accel_y": Signal("mavros-imu-data_raw", "field.linear_acceleration.y", "sensor",
+                      unit="m/s^2"),
     # servo outputs (~3 Hz). ALFA does not name the channels; the mapping follows the
     # data: channels4 and 5 track roll rate (ailerons, r ~ 0.6-0.9), channels1 pitch rate
     # (elevator), channels2 drops to idle at every engine failure (throttle), channels3

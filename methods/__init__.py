@@ -19,6 +19,8 @@ from .end_of_flight import EndOfFlight
 from .ffrls_monitor import FfRlsMonitor
 from .glrt_residuals import GlrtResiduals
 from .kalman_okid import KalmanOkid
+from .learned_fusion import LearnedFusion
+from .residual_bank import ResidualBank
 from .rls_arx_zscore import RlsArxZscore
 
 __all__ = ["REGISTRY", "Detector", "NotFittedError", "Trace", "fault_free_segments",
@@ -29,6 +31,8 @@ REGISTRY: dict[str, type[Detector]] = {
     "glrt_residuals": GlrtResiduals,
     "ffrls_monitor": FfRlsMonitor,
     "kalman_okid": KalmanOkid,
+    "residual_bank": ResidualBank,
+    "learned_fusion": LearnedFusion,
     "emulation_oracle": EmulationOracle,
     "end_of_flight": EndOfFlight,
 }

@@ -41,7 +41,13 @@ def attitude_rows(t_ns, commanded, measured) -> list[str]:
 
 
 IMU_HEADER = ("%time,field.header.seq,field.header.stamp,field.header.frame_id,"
-              "field.angular_velocity.x,field.angular_velocity.y,field.angular_velocity.z")
+              "field.angular_velocity.x,field.angular_velocity.y,field.angular_velocity.z,"
+              "field.linear_acceleration.x,field.linear_acceleration.y,"
+              "field.linear_acceleration.z")
+
+#: steps in the specific force at onset (m/s^2), by ground-truth topic: thrust lost, and
+#: the sideslip of a stuck rudder
+ACCEL_STEPS = {"failure_status-engines": (-1.5, 0.0), "failure_status-rudder": (0.0, 1.0)}
 RC_HEADER = ("%time,field.header.seq,field.header.stamp,field.header.frame_id,"
              + ",".join(f"field.channels{i}" for i in range(8)))
 
@@ -66,7 +72,11 @@ def rate_topics(folder: Path, name: str, duration_s: float, onset_s: float | Non
     the throttle at 2.5 Hz, from a random stream of their own (``seed``). As ALFA's
     emulation does, the failed actuator of ``emulation`` (ground-truth topic, code)
     goes flat at onset: the throttle to idle (vfr_hud to 0), the rudder where it is;
-    the elevator and aileron channels too with ``emulate_surfaces``."""
+    the elevator and aileron channels too with ``emulate_surfaces``.
+
+    The specific force (same IMU rows, a stream of its own) is
+    a_x = 0.5 + 0.3 sin(0.3 t), a_y = 0.5 r, a_z = -9.81, each plus noise, with the
+    step of :data:`ACCEL_STEPS` from onset."""
     rc_t = np.arange(0.0, duration_s, 1 / 3)
     da = 0.3 * np.sin(0.8 * rc_t) + rng.uniform(-0.2, 0.2, rc_t.size)
     de = 0.2 * np.sin(0.5 * rc_t + 1) + rng.uniform(-0.2, 0.2, rc_t.size)
@@ -99,11 +109,18 @@ def rate_topics(folder: Path, name: str, duration_s: float, onset_s: float | Non
     p = gain * 2.5 * da[held] + rng.normal(0, 0.05, imu_t.size)
     q = gain * 2.0 * de[held] + rng.normal(0, 0.05, imu_t.size)
     r = arx_response(da[held], 0.9, 0.1, rng.normal(0, 0.01, imu_t.size))
+    force = np.random.default_rng(seed + 3000)
+    after = imu_t >= onset_s if onset_s is not None else np.zeros(imu_t.size, dtype=bool)
+    step_x, step_y = ACCEL_STEPS.get(emulation[0] if emulation else None, (0.0, 0.0))
+    ax = 0.5 + 0.3 * np.sin(0.3 * imu_t) + step_x * after + force.normal(0, 0.1, imu_t.size)
+    ay = 0.5 * r + step_y * after + force.normal(0, 0.05, imu_t.size)
+    az = -9.81 + force.normal(0, 0.2, imu_t.size)
     imu_ns = T0_NS + 3_000_000 + np.round(imu_t * 1e9).astype(np.int64)
     write_csv(folder / f"{name}-mavros-imu-data_raw.csv", IMU_HEADER,
-              [f"{t},{i},{t - 100_000},base_link,{a!r},{b!r},{c!r}"
-               for i, (t, a, b, c) in enumerate(zip(imu_ns.tolist(), p.tolist(), q.tolist(),
-                                                    r.tolist(), strict=True))])
+              [f"{t},{i},{t - 100_000},base_link,{a!r},{b!r},{c!r},{d!r},{e!r},{g!r}"
+               for i, (t, a, b, c, d, e, g) in enumerate(zip(
+                   imu_ns.tolist(), p.tolist(), q.tolist(), r.tolist(), ax.tolist(),
+                   ay.tolist(), az.tolist(), strict=True))])
 
 
 def write_csv(path: Path, header: str, rows: list[str]) -> None:
@@ -140,6 +157,7 @@ def write_flight(processed: Path, name: str, *, duration_s: float = 80.0, rate_h
         write_csv(folder / f"{name}-{fault_topic}.csv", "%time,field.data",
                   [f"{t},{code}" for t in gt_ns.tolist()])
     airspeed_topic(folder, name, t_ns + 5_000_000, rate_hz, np.random.default_rng(seed + 1000))
+    errors_topic(folder, name, t_ns + 6_000_000, rate_hz, np.random.default_rng(seed + 4000))
     return folder
 
 
@@ -152,6 +170,22 @@ def airspeed_topic(folder: Path, name: str, t_ns: np.ndarray, rate_hz: float,
     measured = 15.0 + arx_response(commanded - 15.0, 0.95, 0.05, rng.normal(0, 0.05, n))
     write_csv(folder / f"{name}-mavros-nav_info-airspeed.csv", ATTITUDE_HEADER,
               attitude_rows(t_ns, commanded, measured))
+
+
+ERRORS_HEADER = ("%time,field.header.seq,field.header.stamp,field.header.frame_id,"
+                 "field.alt_error,field.aspd_error,field.xtrack_error,field.wp_dist")
+
+
+def errors_topic(folder: Path, name: str, t_ns: np.ndarray, rate_hz: float,
+                 rng: np.random.Generator) -> None:
+    """nav_info-errors: an altitude error wandering about a flight's own offset (m)."""
+    n = t_ns.size
+    alt = rng.uniform(-10, 10) + arx_response(rng.normal(0, 1, n), 0.99, 0.05,
+                                              np.zeros(n))
+    seq = np.arange(n) + 500
+    write_csv(folder / f"{name}-mavros-nav_info-errors.csv", ERRORS_HEADER,
+              [f"{t},{s},{t - 120_000},NED,{a!r},0.0,0.0,10"
+               for t, s, a in zip(t_ns.tolist(), seq.tolist(), alt.tolist(), strict=True)])
 
 
 def rename_flight(folder: Path, name: str) -> Path:

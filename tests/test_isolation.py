@@ -77,9 +77,10 @@ def test_the_rls_arx_pairs_name_the_faulty_sensor(corpus, tmp_path, sensor):
 def test_a_signal_names_the_sensor_it_reads():
     assert measured_sensor("roll_error") == "roll" and measured_sensor("pitch") == "pitch"
     assert measured_sensor("roll_rate") == "roll_rate"
+    assert measured_sensor("accel_x") == "accel_x"     # a sensor faults are not injected into
     with pytest.raises(KeyError):
         measured_sensor("servo_aileron_left")
-    assert SENSOR_ACTUATOR["airspeed"] == "engine"
+    assert SENSOR_ACTUATOR["airspeed"] == SENSOR_ACTUATOR["accel_x"] == "engine"
 
 
 def test_confusion_counts_true_against_predicted():
