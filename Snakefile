@@ -24,6 +24,7 @@ include: "rules/inject.smk"
 rule all:
     input:
         rules.tables.output,
+        rules.per_flight.output,
         rules.deadline.output,
         rules.leakage.output,
         rules.runtime.output,

@@ -23,6 +23,22 @@ rule tables:
         "../scripts/tables.py"
 
 
+rule per_flight:
+    input:
+        manifest="data/flights.csv",
+        detections=expand("results/detections/{method}", method=METHODS),
+        traces=expand("results/traces/{method}", method=METHODS),
+    output:
+        csv="results/tables/per_flight.csv",
+        md="results/tables/per_flight.md",
+    params:
+        deadline_s=config["scoring"]["deadline_s"],
+    log:
+        "results/logs/per_flight.log",
+    script:
+        "../scripts/per_flight.py"
+
+
 rule runtime:
     input:
         manifest="data/flights.csv",

@@ -1,0 +1,132 @@
+"""What each run did on each labelled flight: which faults it finds, misses or pre-empts,
+and by how much.
+
+The tables count outcomes; this lists them, so that a miss can be traced to its flight:
+per (method, flight) the outcome under the deadline, the first alarm relative to the
+onset, and the channel that raised it (the earliest of the record's
+``pair_first_alarm_s``). ``verdict`` says it in words: ``detected in 0.48 s (side)``,
+``alarm 10.4 s before onset (thrust)``, ``first alarm 12.6 s after onset, past the
+deadline (pitch)``, ``no alarm``, ``false alarm at 72.0 s (thrust)``.
+
+Margins, from the stored traces, in units of the threshold (a channel alarms above 1):
+``margin_in_time`` is the largest score/threshold of any channel from the onset to the
+deadline, with its ``margin_channel``: how near the fault came to being detected in
+time. ``margin_before`` is the largest before the onset (over the whole flight when
+fault-free): how near the flight came to a false alarm. A fault whose in-time margin is
+below the margins fault-free flying reaches has no signature this method can use at
+any threshold.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from alfa_bench.data import subset_flights
+from alfa_bench.methods import Trace
+
+from .scoring import flight_outcome
+from .tables import BLOCKS, block, fmt, markdown
+
+__all__ = ["margins", "per_flight_markdown", "per_flight_table", "verdict"]
+
+
+def verdict(onset_s: float | None, first_alarm_s: float | None, channel: str | None,
+            deadline_s: float) -> str:
+    """The outcome of one flight in words (module docstring)."""
+    by = f" ({channel})" if channel else ""
+    if first_alarm_s is None:
+        return "no alarm"
+    if onset_s is None:
+        return f"false alarm at {first_alarm_s:.1f} s{by}"
+    delay = first_alarm_s - onset_s
+    if delay < 0:
+        return f"alarm {-delay:.1f} s before onset{by}"
+    if delay > deadline_s:
+        return f"first alarm {delay:.1f} s after onset, past the deadline{by}"
+    return f"detected in {delay:.2f} s{by}"
+
+
+def _first_channel(record: dict) -> str | None:
+    alarms = {c: t for c, t in (record.get("pair_first_alarm_s") or {}).items() if t is not None}
+    return min(alarms, key=alarms.get) if alarms else None
+
+
+def margins(trace: Trace, onset_s: float | None,
+            deadline_s: float) -> tuple[float, str | None, float]:
+    """``(margin_in_time, margin_channel, margin_before)`` of one flight (module
+    docstring); NaN and None where there is no such span or no finite score."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = trace.score / trace.threshold
+    before = trace.t < (math.inf if onset_s is None else onset_s)
+
+    def peak(rows):
+        r = ratio[rows]
+        if not np.isfinite(r).any():
+            return math.nan, None
+        k, c = np.unravel_index(np.nanargmax(r), r.shape)
+        return float(r[k, c]), trace.channels[c]
+
+    in_time = (math.nan, None) if onset_s is None else peak(
+        (trace.t >= onset_s) & (trace.t <= onset_s + deadline_s))
+    return in_time[0], in_time[1], peak(before)[0]
+
+
+def per_flight_table(records: list[dict], traces: dict[tuple[str, str], Trace],
+                     manifest: pd.DataFrame, deadline_s: float,
+                     subset: str = "all") -> pd.DataFrame:
+    """One row per record of a flight of ``subset``: method, block, flight, fault class,
+    emergency trajectory, onset, first alarm, delay, the first channel, the outcome
+    under ``deadline_s``, the verdict and the :func:`margins` from ``traces`` (by
+    method and flight)."""
+    flights = set(subset_flights(manifest, subset))
+    emr = manifest.set_index("flight")["emergency_trajectory"]
+    rows = []
+    for r in records:
+        if r["flight"] not in flights:
+            continue
+        onset, first = r["onset_s"], r["first_alarm_s"]
+        channel = _first_channel(r)
+        in_time, margin_channel, before = margins(traces[r["method"], r["flight"]], onset,
+                                                  deadline_s)
+        rows.append({
+            "method": r["method"], "block": block(r), "flight": r["flight"],
+            "fault_class": r["fault_class"], "emergency_trajectory": bool(emr[r["flight"]]),
+            "onset_s": onset, "first_alarm_s": first,
+            "delay_s": first - onset if onset is not None and first is not None else math.nan,
+            "first_channel": channel,
+            "outcome": flight_outcome(onset, first, deadline_s),
+            "verdict": verdict(onset, first, channel, deadline_s),
+            "margin_in_time": in_time, "margin_channel": margin_channel,
+            "margin_before": before})
+    table = pd.DataFrame(rows)
+    if table.empty:
+        return table
+    order = {b: i for i, b in enumerate(BLOCKS)}
+    return table.sort_values(["block", "method", "flight"],
+                             key=lambda c: c.map(order) if c.name == "block" else c,
+                             kind="stable").reset_index(drop=True)
+
+
+def per_flight_markdown(table: pd.DataFrame, deadline_s: float) -> str:
+    """One Markdown table per method: flight, fault, outcome, verdict and margins."""
+    if table.empty:
+        return "No labelled flight was scored.\n"
+    sections = []
+    for method, rows in table.groupby("method", sort=False):
+        mark = {"honest": "", "reads actuators": " (MARKED: reads actuators)",
+                "reference": " (reference)"}[rows["block"].iloc[0]]
+        sections.append((f"`{method}`{mark}, deadline {deadline_s:g} s",
+                         ["flight", "fault", "emr", "outcome", "what happened",
+                          f"largest score/threshold, onset to +{deadline_s:g} s",
+                          "largest before onset"],
+                         [[f"`{r['flight']}`", r["fault_class"],
+                           "yes" if r["emergency_trajectory"] else "",
+                           fmt(r["outcome"]), r["verdict"],
+                           (f"{fmt(r['margin_in_time'])} ({r['margin_channel']})"
+                            if isinstance(r["margin_channel"], str) else "-"),
+                           fmt(r["margin_before"])]
+                          for r in rows.to_dict(orient="records")]))
+    return markdown(sections)
