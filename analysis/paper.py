@@ -17,7 +17,13 @@ n" fault-free flights), ``best:<s>`` and ``bestaccuracy:<s>`` (the best honest m
 ``tied:<s>`` (the runs the exact McNemar test cannot tell apart from it),
 ``recallnofa:<m>:<s>`` (the best recall of the threshold sweep with no false alarm on
 any flight, %), ``leak:<sig>:<c>`` ("k of n" flights on which the signal goes flat at
-onset) and ``leakchance:<sig>:<c>`` (its larger chance rate, %), ``paper:precision``,
+onset) and ``leakchance:<sig>:<c>`` (its larger chance rate, %), ``classdetected:<m>:<s>:<c>``
+("k of n" faults of class ``c`` detected in time; "n/a" where the subset has none);
+from the per-flight table (:mod:`.per_flight`, all labelled flights), in units of the
+threshold: ``marginmax:<m>:<c>`` and ``marginmin:<m>:<c>`` (the largest and smallest
+in-time margin over the faults of class ``c``), ``marginbefore:<m>`` (the largest
+margin before onset, or on a fault-free flight, over all flights),
+``paper:precision``,
 ``paper:recall``, ``paper:accuracy``, ``paper:meandet``, ``paper:maxdet`` (Keipour et
 al. 2019, quoted).
 """
@@ -52,8 +58,9 @@ def _sec(v: float) -> str:
     return "n/a" if math.isnan(v) else f"{v:.2f}"
 
 
-def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame,
-                  leakage: pd.DataFrame) -> dict[str, str]:
+def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.DataFrame,
+                  by_fault: pd.DataFrame | None = None,
+                  per_flight: pd.DataFrame | None = None) -> dict[str, str]:
     """Every quotable number, as text, by key (see the module docstring)."""
     out = {f"paper:{k}": (_pct if k in ("precision", "recall", "accuracy") else _sec)(
         ICRA2019_SUMMARY[key])
@@ -93,6 +100,26 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame,
         out[f"leak:{key}"] = f"{r['flat_at_onset']} of {r['flights']}"
         out[f"leakchance:{key}"] = _pct(float(np.nanmax([r["chance_before_onset"],
                                                           r["chance_fault_free"]])))
+    out |= {f"classdetected:{m}:{s}:{c}": "n/a" for m, s in
+            comparison[["method", "subset"]].itertuples(index=False)
+            for c in FAULT_ORDER if c != "none"}
+    for r in ([] if by_fault is None else by_fault.to_dict(orient="records")):
+        if r["fault_class"] not in ("none", "total"):
+            out[f"classdetected:{r['method']}:{r['subset']}:{r['fault_class']}"] = (
+                f"{r['detected']} of {r['flights']}")
+    methods = comparison["method"].unique()
+    out |= {f"{k}:{m}:{c}": "n/a" for k in ("marginmax", "marginmin") for m in methods
+            for c in FAULT_ORDER if c != "none"}
+    out |= {f"marginbefore:{m}": "n/a" for m in methods}
+    if per_flight is not None and not per_flight.empty:
+        for (m, c), rows in per_flight.groupby(["method", "fault_class"]):
+            margin = rows["margin_in_time"].dropna()
+            if c != "none" and len(margin):
+                out[f"marginmax:{m}:{c}"] = f"{margin.max():.2f}"
+                out[f"marginmin:{m}:{c}"] = f"{margin.min():.2f}"
+        for m, rows in per_flight.groupby("method"):
+            if rows["margin_before"].notna().any():
+                out[f"marginbefore:{m}"] = f"{rows['margin_before'].max():.2f}"
     return out
 
 

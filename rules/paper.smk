@@ -3,6 +3,7 @@ import shutil
 # The manuscript's inputs: every file it includes is written by the workflow.
 PAPER_INPUTS = [
     *rules.tables.output,
+    *rules.per_flight.output,
     *rules.deadline.output,
     *rules.leakage.output,
     "results/tables/sweep.csv",
@@ -19,6 +20,8 @@ rule paper_sources:
         PAPER_INPUTS,
         manifest="data/flights.csv",
         comparison="results/tables/comparison.csv",
+        by_fault="results/tables/by_fault.csv",
+        per_flight="results/tables/per_flight.csv",
         sweep="results/tables/sweep.csv",
         leakage="results/tables/leakage.csv",
         tex=PAPER_DIR / "paper.tex",

@@ -57,6 +57,25 @@ def test_numbers_come_from_the_tables():
     assert n["paper:accuracy"] == "86.36"
 
 
+def test_per_class_numbers_come_from_the_by_fault_table():
+    by_fault = pd.DataFrame({"method": ["a"] * 3, "subset": ["all"] * 3,
+                             "fault_class": ["engine", "none", "total"],
+                             "flights": [4, 2, 6], "detected": [3, 0, 3]})
+    n = paper_numbers(comparison(), sweep(), leakage(), by_fault)
+    assert n["classdetected:a:all:engine"] == "3 of 4"
+    assert n["classdetected:a:all:aileron"] == "n/a"     # no aileron flight here
+    assert "classdetected:a:all:none" not in n and "classdetected:a:all:total" not in n
+
+
+def test_margins_come_from_the_per_flight_table():
+    per_flight = pd.DataFrame({"method": ["a"] * 3, "fault_class": ["engine", "engine", "none"],
+                               "margin_in_time": [0.64, 1.83, float("nan")],
+                               "margin_before": [0.3, 1.2, 2.18]})
+    n = paper_numbers(comparison(), sweep(), leakage(), None, per_flight)
+    assert n["marginmax:a:engine"] == "1.83" and n["marginmin:a:engine"] == "0.64"
+    assert n["marginbefore:a"] == "2.18" and n["marginmax:a:aileron"] == "n/a"
+
+
 def test_markdown_refuses_unknown_keys_and_missing_files(tmp_path):
     (tmp_path / "t.md").write_text("| x |\n")
     text = render_markdown("<!-- {{num:ignored}} -->A {{num:k}} {{file:t.md}}", {"k": "1"},
