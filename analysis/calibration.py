@@ -1,6 +1,7 @@
 """Leave-one-group-out folds: no flight is scored by a model or threshold that saw it.
 
-Each fold holds out one group of flights (a day, by default, since flights of one
+Each fold (scikit-learn's :class:`~sklearn.model_selection.LeaveOneGroupOut`) holds out
+one group of flights (a day, by default, since flights of one
 day share the aircraft's trim, wind and the segments of one recording) and
 calibrates on the fault-free data of every other flight with ground truth.
 """
@@ -8,6 +9,7 @@ calibrates on the fault-free data of every other flight with ground truth.
 from __future__ import annotations
 
 import pandas as pd
+from sklearn.model_selection import LeaveOneGroupOut
 
 __all__ = ["GROUPINGS", "folds"]
 
@@ -21,12 +23,13 @@ def folds(manifest: pd.DataFrame, group_by: str) -> dict[str, tuple[list[str], l
     if group_by not in GROUPINGS:
         raise ValueError(f"group_by must be one of {sorted(GROUPINGS)}, got {group_by!r}")
     labelled = manifest[manifest["ground_truth"]]
-    groups = labelled[GROUPINGS[group_by]].astype(str)
-    out = {}
-    for g in dict.fromkeys(groups):
-        held = groups == g
-        out[g] = (labelled.loc[held, "flight"].tolist(), labelled.loc[~held, "flight"].tolist())
-    if len(out) < 2:
+    groups = labelled[GROUPINGS[group_by]].astype(str).to_numpy()
+    found = len(dict.fromkeys(groups))
+    if found < 2:
         raise ValueError(f"calibration needs flights from at least two {group_by} groups; "
-                         f"found {len(out)}")
-    return out
+                         f"found {found}")
+    flights = labelled["flight"].to_numpy()
+    out = {}
+    for train, test in LeaveOneGroupOut().split(flights, groups=groups):
+        out[groups[test[0]]] = (flights[test].tolist(), flights[train].tolist())
+    return {g: out[g] for g in dict.fromkeys(groups)}            # in manifest order
