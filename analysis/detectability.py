@@ -29,6 +29,13 @@ from .tables import fmt, markdown
 __all__ = ["detectability_figure", "detectability_markdown", "detectability_table"]
 
 _KEYS = ["method", "sensor", "kind", "magnitude"]
+_COUNTS = ["flights", "detected", "alarmed_before_onset", "missed", "detection_rate",
+           "chance_rate", "mean_detection_s", "max_detection_s"]
+
+#: what the table and figure say when the grid is empty
+EMPTY = ("No injected sensor fault was scored: sensor faults are injected into fault-free "
+         "flights, and this corpus has none with the configured sensors measured "
+         "(results/injected/skipped.csv lists the pairs left out).")
 
 
 def detectability_table(records: list[dict], manifest: pd.DataFrame,
@@ -46,7 +53,7 @@ def detectability_table(records: list[dict], manifest: pd.DataFrame,
                      "kind": row["fault_kind"], "magnitude": float(row["fault_magnitude"]),
                      "outcome": r["outcome"], "detection_s": r["detection_s"],
                      "chance": chance == "TP"})
-    flights = pd.DataFrame(rows)
+    flights = pd.DataFrame(rows, columns=[*_KEYS, "outcome", "detection_s", "chance"])
     out = []
     for key, g in flights.groupby(_KEYS, sort=False):
         times = g["detection_s"].dropna().astype(float)
@@ -58,7 +65,7 @@ def detectability_table(records: list[dict], manifest: pd.DataFrame,
                     "chance_rate": float(g["chance"].mean()),
                     "mean_detection_s": float(times.mean()) if len(times) else np.nan,
                     "max_detection_s": float(times.max()) if len(times) else np.nan})
-    return pd.DataFrame(out)
+    return pd.DataFrame(out, columns=[*_KEYS, *_COUNTS])
 
 
 def _by_fault(table: pd.DataFrame) -> pd.DataFrame:
@@ -86,6 +93,8 @@ def detectability_markdown(table: pd.DataFrame) -> str:
     """Per fault, each method's detection rate (detected / flights, over all sensors),
     its chance rate and mean detection time; then per sensor, each method's rate over
     all faults."""
+    if table.empty:
+        return EMPTY + "\n"
     by = _by_fault(table)
     methods = list(dict.fromkeys(by["method"]))
     faults = list(dict.fromkeys(zip(by["kind"], by["magnitude"], strict=True)))
@@ -113,6 +122,11 @@ def detectability_markdown(table: pd.DataFrame) -> str:
 def detectability_figure(table: pd.DataFrame, path: str | Path) -> None:
     """Detection rate against fault size (drift, scale) per method, and for the
     faults without a size (stuck, zero) and those beyond the paper (noise, ramp)."""
+    if table.empty:
+        fig = plt.figure(figsize=(13, 1.5))
+        fig.text(0.5, 0.5, EMPTY, ha="center", va="center", wrap=True)
+        save(fig, path)
+        return
     by = _by_fault(table)
     methods = list(dict.fromkeys(by["method"]))
     palette = colors(methods)

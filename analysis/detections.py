@@ -6,7 +6,11 @@ of the other folds' flights only, and each record names those flights.
 
 A flight the method cannot read (a topic it needs is missing, a gap in its rows)
 is either the end of the run (strict) or a failure row: the flight then gives
-neither a record nor calibration data, and the failure is logged.
+neither a record nor calibration data, and the failure is logged. So is a fold the
+method cannot calibrate (too little fault-free data for its threshold, a single date
+to leave out): each flight of the fold gets a failure row at stage ``calibration``
+saying why and what to change, and the other folds, and every other method, are
+still scored.
 """
 
 from __future__ import annotations
@@ -40,8 +44,8 @@ from .provenance import provenance, read_table, run_provenance, stamp
 from .scoring import flight_outcome
 from .traces import write_trace
 
-__all__ = ["detect_all", "detection_record", "read_failures", "read_records", "write_detections",
-           "write_record"]
+__all__ = ["calibration_failure", "detect_all", "detection_record", "read_failures",
+           "read_records", "write_detections", "write_record"]
 
 log = logging.getLogger(__name__)
 
@@ -86,6 +90,13 @@ def detect_all(method: str, spec: dict, flights: dict[str, Flight], manifest: pd
         return guarded("detect", name, lambda: detection_record(
             method, spec, detector, flights[name], sha, info, probes))
 
+    def uncalibrated(names: list[str], error: ValueError) -> None:
+        if failures is None:
+            raise error
+        # not added to ``failed``: the flights are still fault-free data for other folds
+        failures.extend(calibration_failure(name, method, error, calibration) for name in names)
+        log.error("%s: %d flight(s) excluded, not calibrated: %s", method, len(names), error)
+
     if not detector.calibrated:
         for name in manifest.loc[manifest["ground_truth"], "flight"]:
             if (out := run(name)) is not None:
@@ -94,7 +105,12 @@ def detect_all(method: str, spec: dict, flights: dict[str, Flight], manifest: pd
     groups = manifest.loc[manifest["ground_truth"]]
     groups = groups.groupby(groups[GROUPINGS[calibration["group_by"]]].astype(str))["flight"]
     scored_by_fold = {g: list(f) for g, f in groups}
-    for fold, (_, training) in folds(train, calibration["group_by"]).items():
+    try:
+        by_fold = folds(train, calibration["group_by"])
+    except ValueError as e:
+        uncalibrated([f for names in scored_by_fold.values() for f in names], e)
+        return
+    for fold, (_, training) in by_fold.items():
         scored = scored_by_fold.pop(fold, [])
         if not scored:
             continue
@@ -104,7 +120,12 @@ def detect_all(method: str, spec: dict, flights: dict[str, Flight], manifest: pd
         dead = {f: list(d) for f in readable
                 if (d := not_measured(flights[f], detector.signals()))}
         used = [f for f in readable if f not in dead]
-        detector.fit([s for f in used for s in segments[f]])
+        try:
+            detector.fit([s for f in used for s in segments[f]])
+        except ValueError as e:
+            uncalibrated(scored, ValueError(f"fold {fold} ({len(used)} calibration flights): "
+                                            f"{e}"))
+            continue
         log.info("%s: fold %s fitted on %d flights", method, fold, len(used))
         info = {**calibration, "fold": fold, "flights": used, "not_measured": dead,
                 "fitted": detector.fitted()}
@@ -112,7 +133,20 @@ def detect_all(method: str, spec: dict, flights: dict[str, Flight], manifest: pd
             if (out := run(name, info)) is not None:
                 yield out
     if scored_by_fold:
-        raise ValueError(f"no calibration flights outside group(s) {sorted(scored_by_fold)}")
+        uncalibrated([f for names in scored_by_fold.values() for f in names],
+                     ValueError(f"no calibration flights outside group(s) "
+                                f"{sorted(scored_by_fold)}"))
+
+
+def calibration_failure(flight: str, method: str, error: ValueError, calibration: dict) -> dict:
+    """A failures-table row for ``flight``, which ``method`` could not be calibrated to
+    score: why, and what to change."""
+    advice = ("add fault-free flights (or flights with more time before onset) from other "
+              "groups")
+    if calibration["group_by"] != "flight":
+        advice += ", or set calibration.group_by: flight to leave out one flight, not one day"
+    return {"flight": flight, "stage": "calibration", "method": method, "file": "",
+            "column": "", "line": "", "error": f"{error}; to calibrate, {advice}"}
 
 
 def detection_record(method: str, spec: dict, detector: Detector, flight: Flight,

@@ -58,11 +58,20 @@ def _sec(v: float) -> str:
     return "n/a" if math.isnan(v) else f"{v:.2f}"
 
 
+#: the keys of one run on one subset, "n/a" for a configured run with no score there
+_PER_RUN = ("precision", "recall", "accuracy", "accuracypaper", "recallpaper", "detected",
+            "meandet", "maxdet", "falsealarms", "recallnofa")
+
+
 def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.DataFrame,
                   by_fault: pd.DataFrame | None = None,
-                  per_flight: pd.DataFrame | None = None) -> dict[str, str]:
-    """Every quotable number, as text, by key (see the module docstring)."""
-    out = {f"paper:{k}": (_pct if k in ("precision", "recall", "accuracy") else _sec)(
+                  per_flight: pd.DataFrame | None = None,
+                  methods=(), subsets=()) -> dict[str, str]:
+    """Every quotable number, as text, by key (see the module docstring). A configured
+    run (``methods``) with no score on a subset (``subsets``), because every flight of
+    it was excluded, quotes "n/a"."""
+    out = {f"{k}:{m}:{s}": "n/a" for k in _PER_RUN for m in methods for s in subsets}
+    out |= {f"paper:{k}": (_pct if k in ("precision", "recall", "accuracy") else _sec)(
         ICRA2019_SUMMARY[key])
         for k, key in (("precision", "precision"), ("recall", "recall"),
                        ("accuracy", "accuracy"), ("meandet", "mean_detection_s"),
@@ -107,10 +116,12 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.Dat
         if r["fault_class"] not in ("none", "total"):
             out[f"classdetected:{r['method']}:{r['subset']}:{r['fault_class']}"] = (
                 f"{r['detected']} of {r['flights']}")
-    methods = comparison["method"].unique()
-    out |= {f"{k}:{m}:{c}": "n/a" for k in ("marginmax", "marginmin") for m in methods
+    runs = [*dict.fromkeys([*methods, *comparison["method"]])]
+    out |= {f"classdetected:{m}:{s}:{c}": "n/a" for m in runs for s in subsets
             for c in FAULT_ORDER if c != "none"}
-    out |= {f"marginbefore:{m}": "n/a" for m in methods}
+    out |= {f"{k}:{m}:{c}": "n/a" for k in ("marginmax", "marginmin") for m in runs
+            for c in FAULT_ORDER if c != "none"}
+    out |= {f"marginbefore:{m}": "n/a" for m in runs}
     if per_flight is not None and not per_flight.empty:
         for (m, c), rows in per_flight.groupby(["method", "fault_class"]):
             margin = rows["margin_in_time"].dropna()

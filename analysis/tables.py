@@ -40,7 +40,7 @@ __all__ = ["BLOCKS", "FAULT_ORDER", "Section", "block", "by_fault_latex", "by_fa
            "by_fault_table", "comparison_latex", "comparison_markdown", "comparison_notes",
            "comparison_table",
            "failures_table", "fmt", "latex_escape", "markdown", "summary_latex",
-           "summary_markdown", "summary_table"]
+           "summary_markdown", "summary_table", "unscored_notes"]
 
 FAULT_ORDER = ("engine", "rudder", "elevator", "aileron", "rudder+aileron", "none")
 
@@ -93,7 +93,9 @@ def _records_for(records: list[dict], manifest: pd.DataFrame, subset: str,
         if missing:
             raise ValueError(f"method {method}: no detection for {len(missing)} flight(s) of "
                              f"subset {subset}, e.g. {missing[0]}, and no failure reported")
-        out[method] = ([recs[f] for f in flights if f in recs], excluded)
+        scored = [recs[f] for f in flights if f in recs]
+        if scored:             # a subset with no flight scored has no row to show
+            out[method] = (scored, excluded)
     return out
 
 
@@ -417,11 +419,34 @@ def by_fault_latex(by_fault: pd.DataFrame) -> str:
     return _latex(_by_fault_sections(by_fault), "by-fault")
 
 
-def comparison_markdown(comparison: pd.DataFrame) -> str:
+def unscored_notes(comparison: pd.DataFrame, failures: pd.DataFrame, manifest: pd.DataFrame,
+                   subsets) -> str:
+    """Per subset, the runs with no row because every flight of the subset was excluded
+    for them (a fold they could not calibrate, flights they could not read); empty when
+    every run was scored."""
+    lines = []
+    own = failures[failures["method"].fillna("") != ""] if len(failures) else failures
+    for subset in subsets:
+        flights = set(subset_flights(manifest, subset))
+        scored = set(comparison.loc[comparison["subset"] == subset, "method"]) \
+            if len(comparison) else set()
+        for method, rows in own.groupby("method", sort=False) if len(own) else []:
+            rows = rows[rows["flight"].isin(flights)]
+            if method in scored or not len(rows):
+                continue
+            stages = ", ".join(dict.fromkeys(rows["stage"]))
+            lines.append(f"- `{method}` on `{subset}`: all {len(rows)} flights excluded "
+                         f"({stages}); `results/tables/failures.csv` says why and what to "
+                         "change.")
+    return "\n### Runs not scored\n\n" + "\n".join(lines) + "\n" if lines else ""
+
+
+def comparison_markdown(comparison: pd.DataFrame, unscored: str = "") -> str:
     """One table per subset, in blocks; the ICRA 2019 paper's row under ``icra22``; which
-    differences the data cannot tell apart."""
+    differences the data cannot tell apart; then ``unscored`` (:func:`unscored_notes`)."""
     return (markdown(_comparison_sections(comparison))
-            + "\n### Which differences the data can tell\n\n" + comparison_notes(comparison))
+            + "\n### Which differences the data can tell\n\n" + comparison_notes(comparison)
+            + unscored)
 
 
 def comparison_latex(comparison: pd.DataFrame) -> str:

@@ -139,11 +139,13 @@ def scan_flights(processed: str | Path) -> tuple[pd.DataFrame, pd.DataFrame]:
     return manifest, pd.DataFrame(failures, columns=[*FAILURE_COLUMNS, "subsets"])
 
 
-def build_manifest(processed: str | Path) -> pd.DataFrame:
+def build_manifest(processed: str | Path, allow_empty: bool = False) -> pd.DataFrame:
     """Load every flight under ``processed`` and return the validated manifest;
-    the first flight that cannot be read raises its :class:`AlfaDataError`."""
+    the first flight that cannot be read raises its :class:`AlfaDataError`. No flight
+    at all is an error too, unless ``allow_empty`` (the injected grid of a corpus
+    without fault-free flights)."""
     rows = [manifest_row(load_flight(p)) for p in find_flights(Path(processed))]
-    if not rows:
+    if not rows and not allow_empty:
         raise AlfaDataError(f"no flights found under {processed}")
     manifest = pd.DataFrame(rows, columns=COLUMNS)
     validate_manifest(manifest)

@@ -14,6 +14,8 @@ sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 grid = sm.params.injection
 manifest = read_manifest(sm.input.manifest)
+# a corpus without fault-free flights gives an empty grid, not a missing folder
+Path(sm.output.processed).mkdir(parents=True, exist_ok=True)
 flights, skipped = inject_grid(Path(sm.input.processed), manifest,
                       Path(sm.output.processed), grid["sensors"], grid["faults"],
                       grid["onsets"])
@@ -22,4 +24,4 @@ logging.info("%d injected flights; %d flight-sensor pairs skipped", len(flights)
 pd.DataFrame(skipped, columns=["flight", "sensor", "reason"]).to_csv(sm.output.skipped,
                                                                      index=False)
 stamp(sm.output.skipped, run_provenance(sm.config, manifest))
-build_manifest(sm.output.processed).to_csv(sm.output.manifest, index=False)
+build_manifest(sm.output.processed, allow_empty=True).to_csv(sm.output.manifest, index=False)

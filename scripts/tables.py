@@ -20,6 +20,7 @@ from alfa_bench.analysis import (
 )
 from alfa_bench.analysis.logs import log_to
 from alfa_bench.analysis.provenance import run_provenance, stamp
+from alfa_bench.analysis.tables import unscored_notes
 from alfa_bench.data import read_manifest
 
 sm = snakemake  # noqa: F821
@@ -38,7 +39,8 @@ by_fault.to_csv(sm.output.by_fault, index=False)
 comparison.to_csv(sm.output.comparison, index=False)
 Path(sm.output.summary_md).write_text(summary_markdown(summary))
 Path(sm.output.by_fault_md).write_text(by_fault_markdown(by_fault))
-Path(sm.output.comparison_md).write_text(comparison_markdown(comparison))
+Path(sm.output.comparison_md).write_text(comparison_markdown(
+    comparison, unscored_notes(comparison, failures, manifest, sm.params.subsets)))
 Path(sm.output.summary_tex).write_text(summary_latex(summary))
 Path(sm.output.by_fault_tex).write_text(by_fault_latex(by_fault))
 Path(sm.output.comparison_tex).write_text(comparison_latex(comparison))

@@ -69,3 +69,30 @@ def test_records_name_their_calibration_flights_and_fitted_values(corpus, manife
         assert all(date[f] != cal["fold"] for f in cal["flights"])
         assert np.all(np.isfinite(cal["fitted"]["threshold"]))
         assert cal["group_by"] == "date" and cal["margin_s"] == 1.0
+
+
+def test_a_fold_that_cannot_calibrate_is_a_failure_row_not_the_end(flights, manifest):
+    """One method, one fold it cannot fit: those flights become failure rows saying what
+    to change, the other folds are scored; strict (no failure list) still stops."""
+    # P_F = 1.5e-4 needs 6667 fault-free samples: the folds that leave out two flights
+    # of the synthetic corpus have about 5600, the others about 7500
+    spec = {"detector": "glrt_residuals", "params": {"false_alarm": 1.5e-4}}
+    failures = []
+    records = [r for r, _ in detect_all("glrt", spec, flights, manifest, CALIBRATION,
+                                        failures)]
+    failed = {f["flight"] for f in failures}
+    assert records and failed and all(f["stage"] == "calibration" for f in failures)
+    assert all("calibration.group_by: flight" in f["error"] for f in failures)
+    assert {r["flight"] for r in records} | failed == set(manifest["flight"])
+    assert not {r["flight"] for r in records} & failed
+    with pytest.raises(ValueError, match="cannot resolve P_F"):
+        list(detect_all("glrt", spec, flights, manifest, CALIBRATION))
+
+
+def test_a_single_date_is_a_failure_row_for_every_flight(flights, manifest):
+    one_day = manifest[manifest["date"] == manifest["date"].iloc[0]]
+    failures = []
+    spec = {"detector": "glrt_residuals", "params": {}}
+    assert list(detect_all("glrt", spec, flights, one_day, CALIBRATION, failures)) == []
+    assert sorted(f["flight"] for f in failures) == sorted(one_day["flight"])
+    assert all("at least two date groups" in f["error"] for f in failures)
