@@ -9,6 +9,8 @@ reruns.
 
 from __future__ import annotations
 
+import ast
+import importlib
 import json
 import struct
 import subprocess
@@ -22,7 +24,7 @@ import pandas as pd
 
 from .calibration import folds
 
-__all__ = ["PACKAGES", "code_version", "package_versions", "provenance", "read_provenance",
+__all__ = ["PACKAGES", "code_version", "module_sources", "package_versions", "provenance", "read_provenance",
            "read_table", "run_provenance", "stamp"]
 
 _CSV_PREFIX = "# provenance: "
@@ -46,6 +48,41 @@ def code_version() -> dict:
     commit = git("rev-parse", "HEAD")
     dirty = bool(git("status", "--porcelain", "--untracked-files=no")) if commit else None
     return {"version": metadata.version("alfa-bench"), "git_commit": commit, "git_dirty": dirty}
+
+
+def module_sources(cls: type) -> list[str]:
+    """The source files of the module defining ``cls`` and of every ``alfa_bench`` module
+    it imports, transitively: the code a job that runs ``cls`` depends on. A workflow
+    rule takes them as inputs, so that a changed module re-runs exactly the jobs of the
+    detectors that use it. (``from . import x`` names the submodule ``x`` only, not its
+    package, whose ``__init__`` imports every detector.)"""
+    found: dict[str, str] = {}
+    todo = [cls.__module__]
+    while todo:
+        name = todo.pop()
+        if name in found:
+            continue
+        module = importlib.import_module(name)
+        found[name] = module.__file__
+        for node in ast.walk(ast.parse(Path(module.__file__).read_text())):
+            if isinstance(node, ast.Import):
+                todo += [a.name for a in node.names if a.name.startswith("alfa_bench")]
+            elif isinstance(node, ast.ImportFrom):
+                base = ("." * node.level + (node.module or "")) if node.level else node.module
+                base = importlib.util.resolve_name(base, module.__package__)
+                if not base.startswith("alfa_bench"):
+                    continue
+                names = [] if node.module is None else [base]
+                todo += [m for m in (*names, *(f"{base}.{a.name}" for a in node.names))
+                         if m == base or _is_module(m)]
+    return sorted(found.values())
+
+
+def _is_module(name: str) -> bool:
+    try:
+        return importlib.util.find_spec(name) is not None
+    except ModuleNotFoundError:
+        return False
 
 
 @cache

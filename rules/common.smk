@@ -3,7 +3,8 @@ from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
 
-from alfa_bench.methods import make_detector
+from alfa_bench.analysis.provenance import module_sources
+from alfa_bench.methods import REGISTRY, make_detector
 
 METHODS = list(config["methods"])
 # the runs scored on the injected sensor faults and for isolation: the reference rows
@@ -21,6 +22,13 @@ for _name, _spec in config["methods"].items():
     if not _detector.causal and _spec.get("role", "method") != "reference":
         raise WorkflowError(f"config methods.{_name}: detector {_spec['detector']!r} is not "
                             "causal, so it can only be a reference row (role: reference)")
+
+
+def detector_code(method):
+    """The source files of the modules ``method``'s detector runs on: a job's input, so
+    that a changed module re-runs the jobs of the detectors that use it, and no other."""
+    return module_sources(REGISTRY[config["methods"][method]["detector"]])
+
 
 # ALFA_DIR, else the config's alfa_dir, else the downloaded archive.
 _alfa = os.environ.get("ALFA_DIR") or config.get("alfa_dir")

@@ -5,6 +5,7 @@ rule detect:
     input:
         manifest="data/flights.csv",
         processed=PROCESSED,
+        code=lambda w: detector_code(w.method),
     output:
         detections=directory("results/detections/{method}"),
         traces=directory("results/traces/{method}"),

@@ -25,6 +25,7 @@ rule detect_injected:
         processed="results/injected/processed",
         calibrate_on="data/flights.csv",
         real=PROCESSED,
+        code=sorted({f for m in DETECTORS for f in detector_code(m)}),
     output:
         detections=directory("results/injected/detections"),
         traces=directory("results/injected/traces"),

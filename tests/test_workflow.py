@@ -2,6 +2,7 @@
 
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -218,6 +219,29 @@ def test_every_result_file_records_its_provenance(runs, corpus):
         assert all(len(v) == 64 for v in checksums.values()), path
 
 
+def test_a_changed_method_module_reruns_exactly_its_jobs(runs, corpus, tmp_path):
+    """A changed detector module makes a dry run schedule the detect jobs of the runs
+    whose detectors use it (here residual_bank, and learned_fusion on top of it), and no
+    other detect job. (Snakemake compares small inputs by content, so the module's text
+    changes, by one comment line, and is restored byte for byte.)"""
+    module = REPO / "methods/residual_bank.py"
+    grid = tmp_path / "grid.yaml"
+    grid.write_text(yaml.safe_dump({"injection": GRID}))     # the runs' own config
+    text, stat = module.read_bytes(), module.stat()
+    try:
+        module.write_bytes(text + b"# changed by test_workflow\n")
+        env = {**os.environ, "ALFA_DIR": str(corpus.parent)}
+        done = subprocess.run([*SNAKEMAKE, "all", "-n", "--cores", "2", "--snakefile",
+                               str(REPO / "Snakefile"), "--directory", str(runs[1]),
+                               "--configfile", str(REPO / "config/config.yaml"), str(grid)],
+                              env=env, capture_output=True, text=True)
+    finally:
+        module.write_bytes(text)
+        os.utime(module, ns=(stat.st_atime_ns, stat.st_mtime_ns))
+    jobs = re.findall(r"rule detect:.*?wildcards: method=(\w+)", done.stdout, flags=re.S)
+    assert sorted(jobs) == ["learned_fusion", "residual_bank"], done.stdout + done.stderr
+
+
 def test_two_runs_are_byte_identical(runs):
     """Every result is byte-identical between runs, but the rerun recordings: rerun 0.41
     draws its ids from the clock and orders its footer index by a hash map (README,
@@ -279,6 +303,51 @@ def test_strict_mode_stops_at_the_first_broken_flight(broken_corpus, tmp_path):
                         target="results/tables/summary.csv", ok=False)
     log = (tmp_path / "results/logs/manifest.log").read_text()
     assert f"flight {unreadable}" in log and "empty file" in log, done.stderr
+
+
+def _small_corpus(root: Path, specs: dict) -> Path:
+    for name, kw in specs.items():
+        write_flight(root / "processed", name, **kw)
+    return root
+
+
+@pytest.mark.parametrize("specs, why", [
+    # only faulty flights: nothing to inject sensor faults into, and too little
+    # fault-free data before the onsets for a per-sample P_F
+    ({"carbonZ_2018-07-18-15-53-31_1_engine_failure": dict(onset_s=50.0),
+      "carbonZ_2018-07-30-16-29-45_engine_failure_with_emr_traj": dict(onset_s=55.0, seed=2),
+      "carbonZ_2018-09-11-15-06-34_3_rudder_left_failure":
+          dict(onset_s=45.0, fault_topic="failure_status-rudder", code=2, seed=3)},
+     "cannot resolve P_F"),
+    # one date: no day to leave out
+    ({"carbonZ_2018-07-18-15-53-31_1_engine_failure": dict(onset_s=50.0),
+      "carbonZ_2018-07-18-15-53-31_2_no_failure": dict(seed=1),
+      "carbonZ_2018-07-18-16-37-39_1_no_failure": dict(seed=2)},
+     "at least two date groups"),
+], ids=["faulty-only", "one-date"])
+def test_small_and_one_sided_flight_sets_run_to_the_end(specs, why, tmp_path):
+    """A method that cannot be calibrated on such a set ends its own run on those flights
+    (failures.csv, stage calibration, with what to change), and every other method is
+    scored."""
+    root = _small_corpus(tmp_path / "alfa", specs)
+    work = tmp_path / "work"
+    grid = tmp_path / "grid.yaml"
+    grid.write_text(yaml.safe_dump({"injection": GRID}))
+    run_workflow(work, root, "--configfile", str(REPO / "config/config.yaml"), str(grid))
+    failures = read_table(work / "results/tables/failures.csv", keep_default_na=False)
+    calibration = failures[failures["stage"] == "calibration"]
+    assert len(calibration) and calibration["error"].str.contains(why).any()
+    assert calibration["error"].str.contains("calibration.group_by: flight").all()
+    comparison = read_table(work / "results/tables/comparison.csv")
+    uncalibrated = {m for m in calibration["method"]
+                    if m not in set(comparison.loc[comparison["subset"] == "all", "method"])}
+    assert set(comparison["method"]) and uncalibrated
+    text = (work / "results/tables/comparison.md").read_text()
+    assert all(f"`{m}` on `all`: all" in text for m in uncalibrated)
+    assert (work / "paper/build/paper.md").exists()
+    if not any("no_failure" in name for name in specs):
+        grid_table = (work / "results/tables/detectability.md").read_text()
+        assert grid_table.startswith("No injected sensor fault was scored")
 
 
 @pytest.mark.parametrize("config, message", [
