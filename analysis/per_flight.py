@@ -28,7 +28,7 @@ from alfa_bench.data import subset_flights
 from alfa_bench.methods import Trace
 
 from .scoring import flight_outcome
-from .tables import BLOCKS, block, fmt, markdown
+from .tables import BLOCK_MARKS, BLOCKS, block, fmt, markdown
 
 __all__ = ["margins", "per_flight_markdown", "per_flight_table", "verdict"]
 
@@ -116,8 +116,7 @@ def per_flight_markdown(table: pd.DataFrame, deadline_s: float) -> str:
         return "No labelled flight was scored.\n"
     sections = []
     for method, rows in table.groupby("method", sort=False):
-        mark = {"honest": "", "reads actuators": " (MARKED: reads actuators)",
-                "reference": " (reference)"}[rows["block"].iloc[0]]
+        mark = BLOCK_MARKS[rows["block"].iloc[0]]
         sections.append((f"`{method}`{mark}, deadline {deadline_s:g} s",
                          ["flight", "fault", "emr", "outcome", "what happened",
                           f"largest score/threshold, onset to +{deadline_s:g} s",

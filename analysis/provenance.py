@@ -24,8 +24,8 @@ import pandas as pd
 
 from .calibration import folds
 
-__all__ = ["PACKAGES", "code_version", "module_sources", "package_versions", "provenance", "read_provenance",
-           "read_table", "run_provenance", "stamp"]
+__all__ = ["PACKAGES", "code_version", "module_sources", "package_versions", "provenance",
+           "read_provenance", "read_table", "run_provenance", "stamp"]
 
 _CSV_PREFIX = "# provenance: "
 

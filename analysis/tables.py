@@ -36,16 +36,18 @@ from alfa_bench.data import FAILURE_COLUMNS, subset_flights
 from .reference import ICRA2019_BY_FAULT, ICRA2019_NAME, ICRA2019_SUMMARY
 from .scoring import mcnemar_exact, score_records
 
-__all__ = ["BLOCKS", "FAULT_ORDER", "Section", "block", "by_fault_latex", "by_fault_markdown",
-           "by_fault_table", "comparison_latex", "comparison_markdown", "comparison_notes",
-           "comparison_table",
-           "failures_table", "fmt", "latex_escape", "markdown", "summary_latex",
-           "summary_markdown", "summary_table", "unscored_notes"]
+__all__ = ["BLOCKS", "BLOCK_MARKS", "FAULT_ORDER", "Section", "block", "by_fault_latex",
+           "by_fault_markdown", "by_fault_table", "comparison_latex", "comparison_markdown",
+           "comparison_notes", "comparison_table", "failures_table", "fmt", "latex_escape",
+           "markdown", "summary_latex", "summary_markdown", "summary_table", "unscored_notes"]
 
 FAULT_ORDER = ("engine", "rudder", "elevator", "aileron", "rudder+aileron", "none")
 
 #: the blocks of runs, in the order the tables list them
 BLOCKS = ("honest", "reads actuators", "reference")
+#: what a section title adds to a run of each block
+BLOCK_MARKS = {"honest": "", "reads actuators": " (MARKED: reads actuators)",
+               "reference": " (reference)"}
 
 _SIGNIFICANCE = 0.05
 
@@ -332,8 +334,7 @@ def _by_fault_sections(by_fault: pd.DataFrame) -> list[Section]:
                 row += [fmt(ref[0]), fmt(ref[1]), fmt(ref[2]), fmt(ref[3]),
                         fmt(ref[4], True)]
             rows.append(row)
-        mark = {"honest": "", "reads actuators": " (MARKED: reads actuators)",
-                "reference": " (reference)"}[table["block"].iloc[0]]
+        mark = BLOCK_MARKS[table["block"].iloc[0]]
         out.append((f"`{method}` on `{subset}`{mark}", header, rows))
     return out
 
