@@ -39,9 +39,8 @@ from alfa_bench.data import Sampled
 
 from . import kernels
 from .arx import ArxRegressor, arx_regressors, fit_arx
-from .base import Detector
 from .glrt import chi2_threshold, empirical_threshold, glrt_statistic
-from .rls_arx_zscore import DEFAULT_PAIRS, RlsArxZscore, pair_signals
+from .rls_arx_zscore import DEFAULT_PAIRS, PairDetector, RlsArxZscore
 
 __all__ = ["GlrtResiduals"]
 
@@ -49,7 +48,7 @@ _RESIDUALS = ("arx", "rls")
 _THRESHOLDS = ("empirical", "chi2")
 
 
-class GlrtResiduals(Detector):
+class GlrtResiduals(PairDetector):
     """Windowed GLRT on per-pair ARX residuals; calibrated on fault-free segments.
 
     Parameters
@@ -99,15 +98,6 @@ class GlrtResiduals(Detector):
         self.warmup_samples = warmup_samples
         self.eps = eps
         self.stable_s = stable_s
-
-    def signals(self) -> tuple[str, ...]:
-        return pair_signals(self.pairs)
-
-    def channels(self) -> tuple[str, ...]:
-        return tuple(p["name"] for p in self.pairs)
-
-    def channel_outputs(self) -> tuple[str, ...]:
-        return tuple(p["output"] for p in self.pairs)
 
     def thresholds(self) -> np.ndarray:
         self._check_fitted("threshold_")

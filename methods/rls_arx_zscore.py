@@ -69,7 +69,7 @@ from alfa_bench.data import Sampled
 from . import kernels
 from .base import Detector
 
-__all__ = ["DEFAULT_PAIRS", "RlsArxZscore", "pair_signals"]
+__all__ = ["DEFAULT_PAIRS", "PairDetector", "RlsArxZscore"]
 
 DEFAULT_PAIRS = (
     {"name": "roll", "input": "roll_cmd", "output": "roll"},
@@ -81,9 +81,22 @@ DEFAULT_PAIRS = (
 _REPEATED = ("hold", "fresh")
 
 
-def pair_signals(pairs) -> tuple[str, ...]:
-    """The signals of input/output ``pairs``, each once, in order of first use."""
-    return tuple(dict.fromkeys(s for p in pairs for s in (p["input"], p["output"])))
+class PairDetector(Detector):
+    """A detector with one score channel per input/output pair of ``self.pairs``
+    (``{"name", "input", "output"}``): the channel is named for the pair and scores its
+    output."""
+
+    pairs: tuple
+
+    def signals(self) -> tuple[str, ...]:
+        """The pairs' signals, each once, in order of first use."""
+        return tuple(dict.fromkeys(s for p in self.pairs for s in (p["input"], p["output"])))
+
+    def channels(self) -> tuple[str, ...]:
+        return tuple(p["name"] for p in self.pairs)
+
+    def channel_outputs(self) -> tuple[str, ...]:
+        return tuple(p["output"] for p in self.pairs)
 
 
 class _Pair:
@@ -118,7 +131,7 @@ class _Pair:
         return bool(self.ints[kernels.VAR_STABLE])
 
 
-class RlsArxZscore(Detector):
+class RlsArxZscore(PairDetector):
     """RLS-ARX z-score detector; see the module docstring for every parameter.
 
     Parameters
@@ -166,15 +179,6 @@ class RlsArxZscore(Detector):
         self.var_stable_s = var_stable_s
         self.z_threshold = z_threshold
         self.repeated_samples = repeated_samples
-
-    def signals(self) -> tuple[str, ...]:
-        return pair_signals(self.pairs)
-
-    def channels(self) -> tuple[str, ...]:
-        return tuple(p["name"] for p in self.pairs)
-
-    def channel_outputs(self) -> tuple[str, ...]:
-        return tuple(p["output"] for p in self.pairs)
 
     def thresholds(self) -> np.ndarray:
         return np.full(len(self.pairs), float(self.z_threshold))
