@@ -31,7 +31,6 @@ rule all:
         rules.sweep.output,
         rules.figures.output,
         rules.flight_figures.output,
-        rules.readme_figure.output,
         rules.rerun_logs.output,
         rules.paper_sources.output,
         rules.detectability.output,

@@ -242,6 +242,28 @@ def test_a_changed_method_module_reruns_exactly_its_jobs(runs, corpus, tmp_path)
     assert sorted(jobs) == ["learned_fusion", "residual_bank"], done.stdout + done.stderr
 
 
+def _expand(path: str) -> list[str]:
+    """``a/{b,c}.d`` -> ``[a/b.d, a/c.d]``; ``<name>`` placeholders become ``*``."""
+    path = re.sub(r"<[^>]+>", "*", path)
+    m = re.search(r"\{([^}]*)\}", path)
+    if not m:
+        return [path]
+    return [q for alt in m.group(1).split(",")
+            for q in _expand(path[:m.start()] + alt + path[m.end():])]
+
+
+def test_every_results_path_the_docs_name_is_made_by_the_workflow(runs):
+    """A results file the README, docs or paper point a reader to must exist after
+    `snakemake all`, or the pointer is stale."""
+    texts = [REPO / "README.md", REPO / "paper/paper.template.md",
+             *sorted((REPO / "docs").glob("*.md"))]
+    named = {p for f in texts for p in re.findall(r"`(results/[^`]*)`", f.read_text())}
+    assert len(named) > 10
+    missing = [p for p in sorted(named) for q in _expand(p)
+               if not list(runs[0].glob(q.rstrip("/")))]
+    assert not missing, missing
+
+
 def test_two_runs_are_byte_identical(runs):
     """Every result is byte-identical between runs, but the rerun recordings: rerun 0.41
     draws its ids from the clock and orders its footer index by a hash map (README,
