@@ -1,10 +1,15 @@
 """Detectors: the streaming contract, the batch runner and the registry.
 
 A new method is one module defining a :class:`Detector` subclass plus one line in
-:data:`REGISTRY`; the contract test then checks it automatically.
+:data:`REGISTRY`; the contract test then checks it automatically. A detector kept in a
+package of its own registers through the entry-point group :data:`PLUGIN_GROUP`
+(``[project.entry-points."alfa_bench.methods"]`` in its ``pyproject.toml``, name =
+``"module:Class"``); once installed it is in :data:`REGISTRY` beside the built-in ones,
+a config run can name it, and the contract test covers it (``examples/alfa-cusum``).
 """
 
 import inspect
+from importlib.metadata import entry_points
 
 from .base import (
     Detector,
@@ -23,10 +28,15 @@ from .learned_fusion import LearnedFusion
 from .residual_bank import ResidualBank
 from .rls_arx_zscore import RlsArxZscore
 
-__all__ = ["REGISTRY", "Detector", "NotFittedError", "Trace", "fault_free_segments",
-           "make_detector", "run_detector", "skipped_channels"]
+__all__ = ["BUILTIN", "PLUGIN_GROUP", "REGISTRY", "Detector", "NotFittedError", "Trace",
+           "fault_free_segments", "make_detector", "plugins", "run_detector",
+           "skipped_channels"]
 
-REGISTRY: dict[str, type[Detector]] = {
+#: the entry-point group third-party detectors register under
+PLUGIN_GROUP = "alfa_bench.methods"
+
+#: the detectors that ship with alfa-bench
+BUILTIN: dict[str, type[Detector]] = {
     "rls_arx_zscore": RlsArxZscore,
     "glrt_residuals": GlrtResiduals,
     "ffrls_monitor": FfRlsMonitor,
@@ -36,6 +46,26 @@ REGISTRY: dict[str, type[Detector]] = {
     "emulation_oracle": EmulationOracle,
     "end_of_flight": EndOfFlight,
 }
+
+
+def plugins() -> dict[str, type[Detector]]:
+    """The detectors installed packages register under :data:`PLUGIN_GROUP`. A name
+    that shadows a built-in detector, or an entry that is not a :class:`Detector`
+    subclass, is an error naming the package's entry."""
+    found = {}
+    for ep in entry_points(group=PLUGIN_GROUP):
+        where = f"entry point {ep.name} = {ep.value!r} (group {PLUGIN_GROUP})"
+        if ep.name in BUILTIN:
+            raise ImportError(f"{where} would shadow the built-in detector {ep.name!r}")
+        cls = ep.load()
+        if not (isinstance(cls, type) and issubclass(cls, Detector)):
+            raise TypeError(f"{where} is not a Detector subclass")
+        found[ep.name] = cls
+    return found
+
+
+#: every detector a config run can name: the built-in ones and the installed plugins
+REGISTRY: dict[str, type[Detector]] = {**BUILTIN, **plugins()}
 
 
 def make_detector(name: str, params: dict | None = None) -> Detector:

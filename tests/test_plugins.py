@@ -1,0 +1,71 @@
+"""Detectors from other packages: the entry-point registry, and the worked example
+(`examples/alfa-cusum`) installed, checked by the contract test and run by the workflow
+without touching `methods/`."""
+
+import os
+import shutil
+import subprocess
+import sys
+from importlib.metadata import EntryPoint
+from pathlib import Path
+
+import pytest
+import yaml
+
+import alfa_bench.methods as methods
+
+REPO = Path(__file__).resolve().parent.parent
+EXAMPLE = REPO / "examples/alfa-cusum"
+
+
+def test_a_plugin_may_not_shadow_a_builtin_or_be_something_else(monkeypatch):
+    def fake(*entries):
+        monkeypatch.setattr(methods, "entry_points", lambda group: [
+            EntryPoint(name, value, group) for name, value in entries])
+
+    fake(("glrt_residuals", "alfa_bench.methods.end_of_flight:EndOfFlight"))
+    with pytest.raises(ImportError, match="shadow the built-in detector 'glrt_residuals'"):
+        methods.plugins()
+    fake(("thing", "alfa_bench.methods:make_detector"))
+    with pytest.raises(TypeError, match="thing = 'alfa_bench.methods:make_detector'"):
+        methods.plugins()
+    fake(("mine", "alfa_bench.methods.end_of_flight:EndOfFlight"))
+    assert methods.plugins() == {"mine": methods.BUILTIN["end_of_flight"]}
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory):
+    """The example package installed (without dependencies: alfa-bench is here), from a
+    copy so that the build leaves nothing in the checkout, into a folder of its own,
+    which PYTHONPATH then adds: the venv itself stays as it is."""
+    site = tmp_path_factory.mktemp("site")
+    source = shutil.copytree(EXAMPLE, tmp_path_factory.mktemp("src") / EXAMPLE.name)
+    done = subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps",
+                           "--no-build-isolation", "--target", str(site), str(source)],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stdout + done.stderr
+    return {**os.environ, "PYTHONPATH": os.pathsep.join(
+        [str(site), *filter(None, [os.environ.get("PYTHONPATH")])])}
+
+
+def test_the_installed_plugin_is_registered_and_passes_the_contract(installed):
+    done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+                           str(REPO / "tests/test_contract.py"), "-k", "registry:cusum"],
+                          capture_output=True, text=True, env=installed, cwd=REPO)
+    assert done.returncode == 0, done.stdout + done.stderr
+    passed = int(done.stdout.strip().splitlines()[-1].split()[0])
+    assert passed >= 10, done.stdout
+
+
+def test_a_config_run_of_the_plugin_lands_in_the_comparison(installed, corpus, tmp_path):
+    extra = tmp_path / "plugin.yaml"
+    extra.write_text(yaml.safe_dump({"methods": {"cusum_roll": {"detector": "cusum"}}}))
+    env = {**installed, "ALFA_DIR": str(corpus.parent)}
+    done = subprocess.run([sys.executable, "-m", "snakemake", "results/tables/comparison.md",
+                           "--cores", "2", "--quiet", "--snakefile", str(REPO / "Snakefile"),
+                           "--directory", str(tmp_path), "--configfile",
+                           str(REPO / "config/config.yaml"), str(extra)],
+                          capture_output=True, text=True, env=env)
+    assert done.returncode == 0, done.stdout + done.stderr
+    table = (tmp_path / "results/tables/comparison.md").read_text()
+    assert "| cusum_roll | cusum |" in table
