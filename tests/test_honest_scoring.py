@@ -93,3 +93,24 @@ def test_the_manifest_reads_back_its_not_measured_column(corpus, tmp_path):
     manifest = build_manifest(corpus)
     manifest.to_csv(tmp_path / "m.csv", index=False)
     assert list(read_manifest(tmp_path / "m.csv")["not_measured"]) == [""] * len(manifest)
+
+
+def test_a_subset_without_flights_has_no_rows_and_a_fully_excluded_run_is_named(corpus):
+    """A flight set without emergency-trajectory flights scores `emr` as nothing, not as
+    an error; a run every flight of which was excluded is listed as not scored."""
+    import pandas as pd
+
+    from alfa_bench.analysis.tables import unscored_notes
+    from alfa_bench.data import build_manifest
+    manifest = build_manifest(corpus)
+    manifest = manifest[~manifest["emergency_trajectory"]]
+    flights = manifest.loc[manifest["ground_truth"]]
+    records = [_record("a", r.flight, None if math.isnan(r.onset_s) else r.onset_s, None)
+               for r in flights.itertuples()]
+    table = comparison_table(records, manifest, ["all", "emr"], deadline_s=5.0)
+    assert set(table["subset"]) == {"all"}
+    failures = pd.DataFrame([{"flight": f, "stage": "calibration", "method": "b"}
+                             for f in flights["flight"]])
+    notes = unscored_notes(table, failures, manifest, ["all", "emr"])
+    assert f"`b` on `all`: all {len(flights)} flights excluded (calibration)" in notes
+    assert "`a`" not in notes and "`emr`" not in notes
