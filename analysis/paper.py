@@ -22,7 +22,12 @@ onset) and ``leakchance:<sig>:<c>`` (its larger chance rate, %), ``classdetected
 from the per-flight table (:mod:`.per_flight`, all labelled flights), in units of the
 threshold: ``marginmax:<m>:<c>`` and ``marginmin:<m>:<c>`` (the largest and smallest
 in-time margin over the faults of class ``c``), ``marginbefore:<m>`` (the largest
-margin before onset, or on a fault-free flight, over all flights),
+margin before onset, or on a fault-free flight, over all flights); from the injected
+sensor faults: ``sensorfaults`` (injected flights scored), ``sensordetected:<m>`` and
+``sensorchance:<m>`` (detection and chance rates over the whole grid, %),
+``bestsensor`` (the run whose detection rate beats its chance rate by most),
+``sensorisolated:<m>`` (sensor named correctly, % of the injected faults) and
+``actuatorisolated:<m>`` (actuator class named correctly, % of ALFA's fault flights),
 ``paper:precision``,
 ``paper:recall``, ``paper:accuracy``, ``paper:meandet``, ``paper:maxdet`` (Keipour et
 al. 2019, quoted).
@@ -42,7 +47,7 @@ from alfa_bench.data import SIGNALS
 from .reference import ICRA2019_SUMMARY
 from .tables import FAULT_ORDER, latex_escape
 
-__all__ = ["latex_macros", "latex_keys", "paper_numbers", "render_markdown"]
+__all__ = ["latex_macros", "latex_keys", "paper_numbers", "render_markdown", "sensor_numbers"]
 
 _PLACEHOLDER = re.compile(r"\{\{(num|file):([^}]+)\}\}")
 _LATEX_KEY = re.compile(r"\\result\{([^}]+)\}")
@@ -66,10 +71,11 @@ _PER_RUN = ("precision", "recall", "accuracy", "accuracypaper", "recallpaper", "
 def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.DataFrame,
                   by_fault: pd.DataFrame | None = None,
                   per_flight: pd.DataFrame | None = None,
-                  methods=(), subsets=()) -> dict[str, str]:
+                  methods=(), subsets=(), sensors: dict | None = None) -> dict[str, str]:
     """Every quotable number, as text, by key (see the module docstring). A configured
     run (``methods``) with no score on a subset (``subsets``), because every flight of
-    it was excluded, quotes "n/a"."""
+    it was excluded, quotes "n/a". ``sensors`` holds the ``detectability``,
+    ``isolation_sensors`` and ``isolation_actuators`` tables."""
     out = {f"{k}:{m}:{s}": "n/a" for k in _PER_RUN for m in methods for s in subsets}
     out |= {f"paper:{k}": (_pct if k in ("precision", "recall", "accuracy") else _sec)(
         ICRA2019_SUMMARY[key])
@@ -131,6 +137,34 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.Dat
         for m, rows in per_flight.groupby("method"):
             if rows["margin_before"].notna().any():
                 out[f"marginbefore:{m}"] = f"{rows['margin_before'].max():.2f}"
+    return out | sensor_numbers(sensors or {}, runs)
+
+
+def sensor_numbers(tables: dict, runs) -> dict[str, str]:
+    """The injected sensor faults' keys (module docstring) from the ``detectability``,
+    ``isolation_sensors`` and ``isolation_actuators`` tables; "n/a" for a run or a
+    table without rows."""
+    out = {f"{k}:{m}": "n/a" for k in ("sensordetected", "sensorchance", "sensorisolated",
+                                       "actuatorisolated") for m in runs}
+    out |= {"sensorfaults": "0", "bestsensor": "none"}
+    grid = tables.get("detectability")
+    if grid is not None and len(grid):
+        sums = grid.assign(chance=grid["chance_rate"] * grid["flights"]).groupby(
+            "method", sort=False)[["detected", "flights", "chance"]].sum()
+        rate, chance = sums["detected"] / sums["flights"], sums["chance"] / sums["flights"]
+        for m in sums.index:
+            out[f"sensordetected:{m}"], out[f"sensorchance:{m}"] = _pct(rate[m]), _pct(chance[m])
+        out["bestsensor"] = str((rate - chance).idxmax())
+    for key, name in (("sensorisolated", "isolation_sensors"),
+                      ("actuatorisolated", "isolation_actuators")):
+        table = tables.get(name)
+        if table is None or not len(table):
+            continue
+        correct = table["correct"].astype(str).str.lower() == "true"
+        for m, ok in correct.groupby(table["method"], sort=False):
+            out[f"{key}:{m}"] = _pct(float(ok.mean()))
+        if name == "isolation_sensors":
+            out["sensorfaults"] = str(table["flight"].nunique())
     return out
 
 

@@ -129,3 +129,16 @@ def test_latex_tables_escape_and_label():
             "(cannot tell apart) & 10 & 1 \\\\") in tex
     assert "MARKED: reads what the fault emulation writes" in tex
     assert "(11 flights; deadline 5.0 s)" in tex
+
+
+def test_sensor_fault_numbers_come_from_the_grid_and_the_isolation_tables():
+    from alfa_bench.analysis.paper import sensor_numbers
+    grid = pd.DataFrame({"method": ["a", "a", "b"], "flights": [4, 4, 8],
+                         "detected": [4, 2, 2], "chance_rate": [0.5, 0.0, 0.0]})
+    iso = pd.DataFrame({"method": ["a", "a", "b", "b"], "flight": ["x", "y", "x", "y"],
+                        "correct": [True, False, False, False]})
+    n = sensor_numbers({"detectability": grid, "isolation_sensors": iso}, ["a", "b", "c"])
+    assert n["sensordetected:a"] == "75.00" and n["sensorchance:a"] == "25.00"
+    assert n["bestsensor"] == "a" and n["sensorfaults"] == "2"
+    assert n["sensorisolated:a"] == "50.00" and n["sensorisolated:c"] == "n/a"
+    assert n["actuatorisolated:a"] == "n/a"
