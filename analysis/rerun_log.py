@@ -60,22 +60,39 @@ def signal_group(name: str) -> str:
             "m": "altitude"}[sig.unit]
 
 
-def blueprint(methods: list[str], groups: list[str]) -> rrb.Blueprint:
+def blueprint(methods: list[str], groups: list[str], title: str = "",
+              fault_span_s: tuple[float, float] | None = None) -> rrb.Blueprint:
     """Signals on top, all methods' score/threshold with the event log in the middle,
-    one tab per method with its scores and intermediates below."""
-    signals = rrb.Horizontal(*[rrb.TimeSeriesView(origin=f"/signals/{g}", name=g)
-                               for g in groups])
+    one tab per method with its scores and intermediates below.
+
+    Every plot shows the whole flight whatever the time cursor does (an infinite
+    visible time range), and view titles carry ``title`` (the flight and its fault).
+    Playback starts paused; with ``fault_span_s`` (onset, end) the time panel opens
+    with the fault's span selected, so the story of the recording is in view."""
+    whole = rrb.VisibleTimeRange(TIMELINE, start=rrb.TimeRangeBoundary.infinite(),
+                                 end=rrb.TimeRangeBoundary.infinite())
+    suffix = f" — {title}" if title else ""
+
+    def plot(origin, name, **kw):
+        return rrb.TimeSeriesView(origin=origin, name=name, time_ranges=whole, **kw)
+
+    signals = rrb.Horizontal(*[plot(f"/signals/{g}", g + suffix) for g in groups])
     overview = rrb.Horizontal(
-        rrb.TimeSeriesView(origin="/overview", name="score / threshold (alarm above 1)",
-                           axis_y=rrb.ScalarAxis(range=(0.0, 3.0))),
-        rrb.TextLogView(origin="/events", name="events"),
+        plot("/overview", "score / threshold (alarm above 1; bar on top: the fault)" + suffix,
+             axis_y=rrb.ScalarAxis(range=(0.0, 3.0))),
+        rrb.TextLogView(origin="/events", name="events" + suffix),
         column_shares=[3, 2])
     tabs = rrb.Tabs(*[rrb.Horizontal(
-        rrb.TimeSeriesView(origin=f"/methods/{m}/scores", name=f"{m}: scores, thresholds"),
-        rrb.TimeSeriesView(origin=f"/methods/{m}/probes", name=f"{m}: intermediates"),
+        plot(f"/methods/{m}/scores", f"{m}: scores, thresholds"),
+        plot(f"/methods/{m}/probes", f"{m}: intermediates"),
         name=m) for m in methods])
-    return rrb.Blueprint(rrb.Vertical(signals, overview, tabs, row_shares=[2, 2, 3]),
-                         collapse_panels=True)
+    selection = (None if fault_span_s is None else rrb.components.AbsoluteTimeRange(
+        *(round(s * 1e9) for s in fault_span_s)))
+    return rrb.Blueprint(
+        rrb.Vertical(signals, overview, tabs, row_shares=[2, 2, 3]),
+        rrb.TimePanel(state="expanded", timeline=TIMELINE, play_state="paused",
+                      time_selection=selection),
+        rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"))
 
 
 def _series(rec: rr.RecordingStream, path: str, t: np.ndarray, v: np.ndarray, name: str,
@@ -97,11 +114,12 @@ def _events(flight: Flight, traces: dict[str, Trace]) -> list[tuple[float, str, 
                        "WARN"))
         events.append((flight.fault.end_s, "fault end", "INFO"))
     for method, tr in traces.items():
-        for start, stop in tr.alarm_intervals():
+        for i, (start, stop) in enumerate(tr.alarm_intervals()):
             k = int(np.searchsorted(tr.t, start))
             channels = [c for c, a in zip(tr.channels, tr.alarm[k], strict=True) if a]
-            events.append((start, f"alarm {method} ({', '.join(channels)}) until {stop:.2f} s",
-                           "ERROR"))
+            first = "first alarm" if i == 0 else "alarm"
+            events.append((start, f"{first} {method} ({', '.join(channels)}) until "
+                           f"{stop:.2f} s", "ERROR"))
     return sorted(events, key=lambda e: (e[0], e[1]))
 
 
@@ -113,9 +131,12 @@ def write_rerun_log(flight: Flight, traces: dict[str, Trace], signals: list[str]
     path.parent.mkdir(parents=True, exist_ok=True)
     groups = [g for g in _GROUPS if any(signal_group(s) == g for s in signals)]
     rec = rr.RecordingStream(_APPLICATION, recording_id=flight.id, send_properties=False)
-    rec.save(path, default_blueprint=blueprint(list(traces), groups))
-    rec.send_recording_name(flight.id)
     fault = flight.fault
+    span = (None if fault is None or fault.onset_s is None
+            else (fault.onset_s, fault.end_s))
+    title = f"{fault.fault_class if fault else 'unlabelled'}: {flight.id}"
+    rec.save(path, default_blueprint=blueprint(list(traces), groups, title, span))
+    rec.send_recording_name(flight.id)
     rec.send_property("flight", rr.AnyValues(
         flight=flight.id, date=flight.date, label=flight.label,
         fault_class=fault.fault_class if fault else "unknown",
@@ -138,6 +159,9 @@ def write_rerun_log(flight: Flight, traces: dict[str, Trace], signals: list[str]
             _series(rec, f"{base}/probes/{probe}", tr.t, values, probe)
         r = ratio(tr)
         _series(rec, f"overview/{method}", tr.t, np.where(np.isinf(r), np.nan, r), method)
+    if span is not None:
+        # a bar along the top of the overview from onset to the fault's end
+        _series(rec, "overview/fault", np.array(span), np.full(2, 2.9), "fault", _RED)
     _series(rec, "overview/threshold", np.array([0.0, flight.duration_s]), np.ones(2),
             "alarm level", _RED)
 

@@ -2,10 +2,16 @@
 
 import numpy as np
 import pytest
+import rerun.blueprint as rrb
 import rerun.chunk as rc
 from recordings import content
 
-from alfa_bench.analysis.rerun_log import read_rerun_provenance, write_rerun_log
+from alfa_bench.analysis.rerun_log import (
+    TIMELINE,
+    blueprint,
+    read_rerun_provenance,
+    write_rerun_log,
+)
 from alfa_bench.data import load_flight, series
 from alfa_bench.methods import make_detector, run_detector
 
@@ -45,6 +51,7 @@ def test_the_recording_holds_signals_scores_probes_and_events(recording):
     assert rows["/methods/rls/probes/roll/residual"] == int(
         np.isfinite(trace.probes["roll/residual"]).sum())
     assert rows["/overview/rls"] == armed
+    assert rows["/overview/fault"] == 2            # the bar from onset to the fault's end
     alarms = len(trace.alarm_intervals())
     assert rows["/events"] == 2 + alarms        # onset, end, one per alarm
 
@@ -67,3 +74,26 @@ def test_the_same_run_writes_the_same_content(recording):
 def test_the_recording_carries_its_provenance(recording):
     _, _, (path, _) = recording
     assert read_rerun_provenance(path) == {"inputs": {"a": "0" * 64}}
+
+
+def test_the_viewer_opens_paused_on_the_fault_with_the_whole_flight_in_view():
+    bp = blueprint(["m"], ["attitude"], "engine: carbonZ_x", (50.0, 62.5))
+    panel = bp.time_panel
+    assert str(panel.play_state).lower().endswith("paused")
+    assert TIMELINE in repr(panel.timeline)
+    sel = panel.time_selection
+    assert (sel.min.value, sel.max.value) == (50_000_000_000, 62_500_000_000)
+    views = []
+
+    def walk(node):
+        if isinstance(node, rrb.View):
+            views.append(node)
+        else:
+            for child in node.contents:
+                walk(child)
+
+    walk(bp.root_container)
+    plots = [v for v in views if isinstance(v, rrb.TimeSeriesView)]
+    assert len(plots) == 4 and all("VisibleTimeRanges" in v.properties for v in plots)
+    assert sum("engine: carbonZ_x" in str(v.name) for v in views) == 3   # signals, overview
+    assert blueprint(["m"], ["attitude"]).time_panel.time_selection is None
