@@ -86,6 +86,7 @@ from __future__ import annotations
 
 import math
 import re
+from functools import cache
 
 import numpy as np
 from scipy import stats
@@ -120,6 +121,7 @@ _REGRESSOR = re.compile(r"^(?:(sin|tan|sq)\()?([a-z_]+)\)?$")
 MIN_SEGMENTS = 3
 
 
+@cache          # parsed once per name, not at every streaming step
 def regressor_signal(regressor: str) -> tuple[str | None, str]:
     """``"sin(pitch)"`` -> ``("sin", "pitch")``; a bare signal name -> ``(None, name)``."""
     m = _REGRESSOR.match(regressor)
