@@ -1,9 +1,16 @@
 """Snakemake script: download, verify and unpack the ALFA processed flights."""
 
+import logging
+import sys
+
 from alfa_bench.analysis.logs import log_to
 from alfa_bench.data import fetch_alfa
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
+# the progress lines also reach the terminal: a download of a gigabyte is otherwise silent
+progress = logging.StreamHandler(sys.stderr)
+progress.setFormatter(logging.Formatter("download_alfa: %(message)s"))
+logging.getLogger("alfa_bench.data").addHandler(progress)
 d = sm.params.download
-fetch_alfa(d["api"], d["file"], d["dest"], d.get("sha256"))
+fetch_alfa(d["api"], d["file"], d["dest"], d.get("md5"), d.get("sha256"))

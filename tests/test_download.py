@@ -1,97 +1,90 @@
-"""The download path against a loopback HTTP server serving a small archive."""
+"""The download path against a loopback server serving an archive laid out like ALFA's."""
 
 import hashlib
-import http.server
 import io
-import json
-import threading
+import socket
 import zipfile
 
 import pytest
+from loopback import make_archive, serve_archive
 
 from alfa_bench.data import AlfaDataError, build_manifest, fetch_alfa
 
 
-def make_zip(processed, prefix="processed/"):
-    buf = io.BytesIO()
-    with zipfile.ZipFile(buf, "w") as z:
-        for f in sorted(processed.rglob("*.csv")):
-            z.write(f, prefix + str(f.relative_to(processed)))
-    return buf.getvalue()
-
-
-@pytest.fixture
-def server():
-    """A loopback server: /api lists one file as figshare does; /file/1 serves it."""
-    state = {}
-
-    class Handler(http.server.BaseHTTPRequestHandler):
-        def do_GET(self):
-            body = state["api"] if self.path == "/api" else state["files"].get(self.path)
-            if body is None:
-                self.send_error(404)
-                return
-            self.send_response(200)
-            self.send_header("Content-Length", str(len(body)))
-            self.end_headers()
-            self.wfile.write(body)
-
-        def log_message(self, *args):
-            pass
-
-    httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Handler)
-    base = f"http://127.0.0.1:{httpd.server_address[1]}"
-    thread = threading.Thread(target=httpd.serve_forever, daemon=True)
-    thread.start()
-
-    def publish(archive: bytes, md5: str | None = None, name="processed.zip"):
-        state["files"] = {"/file/1": archive}
-        state["api"] = json.dumps([{
-            "id": 1, "name": name, "size": len(archive), "is_link_only": False,
-            "download_url": f"{base}/file/1",
-            "computed_md5": md5 or hashlib.md5(archive).hexdigest(),
-        }]).encode()
-        return f"{base}/api"
-
-    yield publish
-    httpd.shutdown()
-
-
 @pytest.mark.parametrize("prefix", ["processed/", "ALFA/processed/", ""])
-def test_download_verify_unpack(server, corpus, tmp_path, prefix):
-    archive = make_zip(corpus, prefix)
-    api = server(archive)
-    root = fetch_alfa(api, "processed.zip", tmp_path / "alfa",
-                      sha256=hashlib.sha256(archive).hexdigest())
+def test_download_verify_unpack_only_the_csvs(corpus, tmp_path, prefix):
+    archive = make_archive(corpus, prefix)
+    with serve_archive(archive) as (api, _):
+        root = fetch_alfa(api, "processed.zip", tmp_path / "alfa",
+                          md5=hashlib.md5(archive).hexdigest(),
+                          sha256=hashlib.sha256(archive).hexdigest())
     assert root == tmp_path / "alfa"
     assert len(build_manifest(root / "processed")) == len(list(corpus.iterdir()))
+    unpacked = {p.relative_to(root / "processed") for p in (root / "processed").rglob("*")
+                if p.is_file()}
+    assert unpacked == {p.relative_to(corpus) for p in corpus.rglob("*.csv")}
+    assert not (tmp_path / "alfa" / ".unpacking").exists()
 
 
-def test_md5_mismatch_is_refused(server, corpus, tmp_path):
-    api = server(make_zip(corpus), md5="0" * 32)
-    with pytest.raises(AlfaDataError, match="MD5"):
+def test_a_verified_archive_is_not_downloaded_again(corpus, tmp_path):
+    archive = make_archive(corpus)
+    with serve_archive(archive) as (api, requests):
         fetch_alfa(api, "processed.zip", tmp_path / "alfa")
+        fetch_alfa(api, "processed.zip", tmp_path / "alfa")
+    assert requests.count("/file/1") == 1
+
+
+def test_repository_md5_mismatch_is_refused(corpus, tmp_path):
+    with serve_archive(make_archive(corpus), md5="0" * 32) as (api, _):
+        with pytest.raises(AlfaDataError, match="MD5 .* the repository says 0{32}.*Run again"):
+            fetch_alfa(api, "processed.zip", tmp_path / "alfa")
     assert not (tmp_path / "alfa" / "processed").exists()
-    assert not list((tmp_path / "alfa").glob("*.part"))
+    assert not list((tmp_path / "alfa").glob("processed.zip*"))
 
 
-def test_pinned_sha256_mismatch_is_refused(server, corpus, tmp_path):
-    api = server(make_zip(corpus))
-    with pytest.raises(AlfaDataError, match="SHA-256"):
-        fetch_alfa(api, "processed.zip", tmp_path / "alfa", sha256="f" * 64)
+def test_pinned_md5_mismatch_is_refused(corpus, tmp_path):
+    with serve_archive(make_archive(corpus)) as (api, _):
+        with pytest.raises(AlfaDataError, match="the config says 792c.*download.md5"):
+            fetch_alfa(api, "processed.zip", tmp_path / "alfa",
+                       md5="792c36aef2fd1fd19a91a53e3b3dcfdf")
+    assert not list((tmp_path / "alfa").glob("processed.zip*"))
 
 
-def test_missing_file_lists_what_is_there(server, corpus, tmp_path):
-    api = server(make_zip(corpus), name="raw.zip")
-    with pytest.raises(AlfaDataError, match=r"no file 'processed.zip' \(it has: raw.zip\)"):
-        fetch_alfa(api, "processed.zip", tmp_path / "alfa")
+def test_pinned_sha256_mismatch_is_refused(corpus, tmp_path):
+    with serve_archive(make_archive(corpus)) as (api, _):
+        with pytest.raises(AlfaDataError, match="SHA-256"):
+            fetch_alfa(api, "processed.zip", tmp_path / "alfa", sha256="f" * 64)
 
 
-def test_unsafe_member_path_is_refused(server, tmp_path):
+def test_a_truncated_download_says_run_again(corpus, tmp_path):
+    with serve_archive(make_archive(corpus), truncate=True) as (api, _):
+        with pytest.raises(AlfaDataError) as e:
+            fetch_alfa(api, "processed.zip", tmp_path / "alfa")
+    assert "Run again" in str(e.value) and "ALFA_DIR" in str(e.value)
+    assert not list((tmp_path / "alfa").glob("processed.zip*"))
+
+
+def test_no_network_says_what_to_do(tmp_path):
+    with socket.socket() as s:   # a port nothing listens on
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    with pytest.raises(AlfaDataError, match=r"cannot reach .*doi.org/10.1184/R1/12707963.*"
+                                            r"ALFA_DIR"):
+        fetch_alfa(f"http://127.0.0.1:{port}/api", "processed.zip", tmp_path / "alfa")
+
+
+def test_missing_file_lists_what_is_there(corpus, tmp_path):
+    with serve_archive(make_archive(corpus), name="raw.zip") as (api, _):
+        with pytest.raises(AlfaDataError,
+                           match=r"no file 'processed.zip' \(it has: raw.zip\)"):
+            fetch_alfa(api, "processed.zip", tmp_path / "alfa")
+
+
+def test_unsafe_member_path_is_refused(tmp_path):
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w") as z:
         z.writestr("../evil.csv", "x")
-    api = server(buf.getvalue())
-    with pytest.raises(AlfaDataError, match="unsafe path"):
-        fetch_alfa(api, "processed.zip", tmp_path / "alfa")
+    with serve_archive(buf.getvalue()) as (api, _):
+        with pytest.raises(AlfaDataError, match="unsafe path"):
+            fetch_alfa(api, "processed.zip", tmp_path / "alfa")
     assert not (tmp_path / "evil.csv").exists()

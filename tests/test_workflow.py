@@ -1,16 +1,19 @@
 """`snakemake all` end to end on a synthetic corpus: outputs, contents, reproducibility."""
 
+import hashlib
 import json
 import os
 import re
 import shutil
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
 import yaml
 from broken import IMU, ROLL, _gap, edit
+from loopback import make_archive, serve_archive
 from recordings import content
 
 from alfa_bench.analysis.provenance import read_provenance, read_table
@@ -21,9 +24,13 @@ REPO = Path(__file__).resolve().parent.parent
 SNAKEMAKE = [sys.executable, "-m", "snakemake"]
 
 
-def run_workflow(workdir: Path, alfa_dir: Path, *args: str, target: str = "all",
+def run_workflow(workdir: Path, alfa_dir: Path | None, *args: str, target: str = "all",
                  ok: bool = True) -> subprocess.CompletedProcess:
-    env = {**os.environ, "ALFA_DIR": str(alfa_dir)}
+    """Run the workflow in ``workdir``; ``alfa_dir=None`` runs it as the README's first
+    command does, without ALFA_DIR, so that it downloads the archive."""
+    env = {k: v for k, v in os.environ.items() if k != "ALFA_DIR"}
+    if alfa_dir is not None:
+        env["ALFA_DIR"] = str(alfa_dir)
     cmd = [*SNAKEMAKE, target, "--cores", "2", "--snakefile", str(REPO / "Snakefile"),
            "--directory", str(workdir), "--configfile", str(REPO / "config/config.yaml"),
            "--quiet", *args]
@@ -40,13 +47,26 @@ GRID = {"sensors": ["roll", "airspeed", "pitch_rate"],
 
 
 @pytest.fixture(scope="module")
-def runs(corpus, tmp_path_factory):
-    dirs = [tmp_path_factory.mktemp(f"run{i}") for i in range(2)]
-    grid = tmp_path_factory.mktemp("grid") / "grid.yaml"
-    grid.write_text(yaml.safe_dump({"injection": GRID}))
+def overlay(corpus, tmp_path_factory):
+    """The runs' own config: the small grid, and the corpus served as ALFA's archive
+    from a loopback stand-in for KiltHub (its port fixed, so both runs share a config)."""
+    archive = make_archive(corpus)
+    with serve_archive(archive) as (api, requests):
+        path = tmp_path_factory.mktemp("overlay") / "overlay.yaml"
+        path.write_text(yaml.safe_dump({"injection": GRID, "download": {
+            "api": api, "file": "processed.zip", "md5": hashlib.md5(archive).hexdigest(),
+            "sha256": None, "dest": "resources/alfa"}}))
+        yield path, requests
+
+
+@pytest.fixture(scope="module")
+def runs(overlay):
+    """Two runs of the README's first command, each downloading the archive."""
+    config, requests = overlay
+    dirs = [Path(tempfile.mkdtemp(prefix=f"run{i}", dir=config.parent)) for i in range(2)]
     for d in dirs:
-        run_workflow(d, corpus.parent, "--configfile", str(REPO / "config/config.yaml"),
-                     str(grid))
+        run_workflow(d, None, "--configfile", str(REPO / "config/config.yaml"), str(config))
+    assert requests.count("/file/1") == 2
     return dirs
 
 
@@ -219,22 +239,20 @@ def test_every_result_file_records_its_provenance(runs, corpus):
         assert all(len(v) == 64 for v in checksums.values()), path
 
 
-def test_a_changed_method_module_reruns_exactly_its_jobs(runs, corpus, tmp_path):
+def test_a_changed_method_module_reruns_exactly_its_jobs(runs, overlay):
     """A changed detector module makes a dry run schedule the detect jobs of the runs
     whose detectors use it (here residual_bank, and learned_fusion on top of it), and no
     other detect job. (Snakemake compares small inputs by content, so the module's text
     changes, by one comment line, and is restored byte for byte.)"""
     module = REPO / "methods/residual_bank.py"
-    grid = tmp_path / "grid.yaml"
-    grid.write_text(yaml.safe_dump({"injection": GRID}))     # the runs' own config
     text, stat = module.read_bytes(), module.stat()
     try:
         module.write_bytes(text + b"# changed by test_workflow\n")
-        env = {**os.environ, "ALFA_DIR": str(corpus.parent)}
+        env = {k: v for k, v in os.environ.items() if k != "ALFA_DIR"}
         done = subprocess.run([*SNAKEMAKE, "all", "-n", "--cores", "2", "--snakefile",
                                str(REPO / "Snakefile"), "--directory", str(runs[1]),
-                               "--configfile", str(REPO / "config/config.yaml"), str(grid)],
-                              env=env, capture_output=True, text=True)
+                               "--configfile", str(REPO / "config/config.yaml"),
+                               str(overlay[0])], env=env, capture_output=True, text=True)
     finally:
         module.write_bytes(text)
         os.utime(module, ns=(stat.st_atime_ns, stat.st_mtime_ns))
