@@ -66,15 +66,18 @@ def blueprint(methods: list[str], groups: list[str], title: str = "",
     one tab per method with its scores and intermediates below.
 
     Every plot shows the whole flight whatever the time cursor does (an infinite
-    visible time range), and view titles carry ``title`` (the flight and its fault).
+    visible time range and x axis), and view titles carry ``title`` (the flight and its fault).
     Playback starts paused; with ``fault_span_s`` (onset, end) the time panel opens
     with the fault's span selected, so the story of the recording is in view."""
-    whole = rrb.VisibleTimeRange(TIMELINE, start=rrb.TimeRangeBoundary.infinite(),
-                                 end=rrb.TimeRangeBoundary.infinite())
+    ever = rrb.TimeRangeBoundary.infinite()
+    whole = rrb.VisibleTimeRange(TIMELINE, start=ever, end=ever)
+    # the x axis too: left to itself it follows the cursor, 30 s either side of it
+    axis = rrb.TimeAxis(view_range=rrb.TimeRange(start=ever, end=ever))
     suffix = f" — {title}" if title else ""
 
     def plot(origin, name, **kw):
-        return rrb.TimeSeriesView(origin=origin, name=name, time_ranges=whole, **kw)
+        return rrb.TimeSeriesView(origin=origin, name=name, time_ranges=whole, axis_x=axis,
+                                  **kw)
 
     signals = rrb.Horizontal(*[plot(f"/signals/{g}", g + suffix) for g in groups])
     overview = rrb.Horizontal(

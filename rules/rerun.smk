@@ -12,3 +12,19 @@ rule rerun_logs:
         "results/logs/rerun_logs.log",
     script:
         "../scripts/rerun_logs.py"
+
+
+# The README's picture of a recording in rerun's web viewer, taken in headless Chromium
+# (analysis/viewer.py). Refreshed by this explicit target, never by `all`: it writes a
+# tracked file, and needs Chromium.
+rule viewer_screenshot:
+    input:
+        "results/rerun",
+    output:
+        "docs/viewer.png",
+    params:
+        flight=config["figures"].get("viewer_flight", ""),
+    log:
+        "results/logs/viewer_screenshot.log",
+    script:
+        "../scripts/viewer_screenshot.py"
