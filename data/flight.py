@@ -9,7 +9,7 @@ fault is active.
 All times of a flight are put on one clock, seconds from the flight's first
 sample (the earliest ``%time`` of any topic).
 
-Bad input policy (also in the README):
+Bad input policy (also in docs/bad-data.md):
 
 - raised as :class:`AlfaDataError`, naming flight, file, column and line: an empty
   file, a header without rows, a row with the wrong number of fields, a

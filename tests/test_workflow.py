@@ -284,8 +284,8 @@ def test_every_results_path_the_docs_name_is_made_by_the_workflow(runs):
 
 def test_two_runs_are_byte_identical(runs):
     """Every result is byte-identical between runs, but the rerun recordings: rerun 0.41
-    draws its ids from the clock and orders its footer index by a hash map (README,
-    "Inspecting a run"), so their entities, times and values are compared."""
+    draws its ids from the clock and orders its footer index by a hash map (docs/viewer.md),
+    so their entities, times and values are compared."""
     a, b = runs
     skip = {"logs", "benchmarks", "runtime"}                 # times vary between runs
     files = sorted(p.relative_to(a) for p in (a / "results").rglob("*")

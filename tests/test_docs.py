@@ -1,0 +1,36 @@
+"""The README is short, starts with the two commands, quotes no result by hand, and
+every file it or the docs link to is there."""
+
+import re
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+DOCS = [REPO / "README.md", *sorted((REPO / "docs").glob("*.md"))]
+
+
+def test_the_readme_is_short_and_opens_with_the_two_commands():
+    text = (REPO / "README.md").read_text()
+    assert len(text.splitlines()) <= 120
+    block = re.search(r"```bash\n(.*?)```", text, re.S).group(1)
+    commands = [line for line in block.splitlines() if line and not line.startswith("#")]
+    install = 'python3 -m venv .venv && .venv/bin/pip install -q -c constraints.txt -e ".[test]"'
+    assert commands == [f"{install} && .venv/bin/snakemake all --cores 2",
+                        f"{install} && .venv/bin/python -m pytest"]
+
+
+def test_the_readme_quotes_no_result_by_hand():
+    """Rates, counts of flights and run times come from the run (paper/build/paper.md
+    and results/), never typed into the README."""
+    text = (REPO / "README.md").read_text()
+    typed = re.findall(r"\d+(?:\.\d+)? ?%|\b\d+ (?:of|flights|faults|s\b|min)", text)
+    assert not typed, typed
+
+
+def test_every_local_link_resolves():
+    missing = []
+    for doc in DOCS:
+        for target in re.findall(r"\]\(([^)#\s]+)(?:#[^)]*)?\)", doc.read_text()):
+            if not target.startswith(("http://", "https://")) and not (
+                    doc.parent / target).exists():
+                missing.append(f"{doc.relative_to(REPO)} -> {target}")
+    assert not missing, missing
