@@ -131,8 +131,13 @@ def flight_figure(flight: str, onset_s: float | None, end_s: float | None,
     """One panel per method: :math:`\\max_c s_c/\\gamma_c` against the threshold 1,
     within ``window_s`` of the onset (the whole flight if fault-free)."""
     methods = list(traces)
-    fig, axes = plt.subplots(len(methods), 1, figsize=(8, 1.25 * len(methods) + 0.8),
-                             sharex=True, squeeze=False, layout="constrained")
+    height = 1.25 * len(methods) + 0.8
+    fig, axes = plt.subplots(len(methods), 1, figsize=(8, height), sharex=True,
+                             squeeze=False)
+    # fixed margins (in inches): a constrained layout of this many axes took most of
+    # the drawing time
+    fig.subplots_adjust(left=0.2, right=0.98, bottom=0.45 / height, top=1 - 0.75 / height,
+                        hspace=0.12)
     for ax, m in zip(axes[:, 0], methods, strict=True):
         tr = traces[m]
         r = ratio(tr)

@@ -4,23 +4,21 @@
 thresholds and probes, and its provenance (a JSON string, ``provenance``). Alarms
 are not stored: by the detector contract a channel
 alarms exactly when its score exceeds its threshold. The archive is written with
-fixed member dates, so the same trace gives the same bytes.
+fixed member dates (:func:`~alfa_bench.data.cache.write_npz`), so the same trace gives
+the same bytes.
 """
 
 from __future__ import annotations
 
-import io
 import json
-import zipfile
 from pathlib import Path
 
 import numpy as np
 
+from alfa_bench.data.cache import write_npz
 from alfa_bench.methods import Trace
 
 __all__ = ["read_trace", "read_traces", "write_trace"]
-
-_EPOCH = (1980, 1, 1, 0, 0, 0)  # the earliest date a zip member can carry
 
 
 def write_trace(trace: Trace, path: str | Path, provenance: dict) -> None:
@@ -37,15 +35,7 @@ def write_trace(trace: Trace, path: str | Path, provenance: dict) -> None:
                    else np.empty((trace.t.size, 0))),
         "provenance": np.array([json.dumps(provenance, sort_keys=True, allow_nan=False)]),
     }
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
-        for name, a in arrays.items():
-            buf = io.BytesIO()
-            np.lib.format.write_array(buf, np.ascontiguousarray(a), allow_pickle=False)
-            info = zipfile.ZipInfo(f"{name}.npy", date_time=_EPOCH)
-            info.compress_type = zipfile.ZIP_DEFLATED
-            z.writestr(info, buf.getvalue())
+    write_npz(path, arrays, compress=True)
 
 
 def read_trace(path: str | Path) -> Trace:

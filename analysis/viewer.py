@@ -18,6 +18,7 @@ from __future__ import annotations
 import contextlib
 import os
 import shutil
+import signal
 import socket
 import subprocess
 import sys
@@ -61,7 +62,10 @@ def serve_recording(rrd: str | Path, timeout_s: float = 30.0):
     env = {**os.environ, "RERUN_ANALYTICS": "0"}
     # a file, not a pipe: a server that logs more than a pipe holds would block on it
     log = tempfile.TemporaryFile()
-    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=log)
+    # a session of its own: `rerun` is a launcher whose child, the viewer server,
+    # outlives it unless the whole group is stopped
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=log,
+                            start_new_session=True)
     try:
         deadline = time.monotonic() + timeout_s
         while not _answers(f"http://127.0.0.1:{web}/"):
@@ -73,7 +77,7 @@ def serve_recording(rrd: str | Path, timeout_s: float = 30.0):
         source = urllib.parse.quote(f"rerun+http://127.0.0.1:{grpc}/proxy", safe="")
         yield f"http://127.0.0.1:{web}/?url={source}"
     finally:
-        proc.terminate()
+        os.killpg(proc.pid, signal.SIGTERM)
         proc.wait(timeout=10)
         log.close()
 

@@ -1,5 +1,6 @@
 """ALFA data layer: flights, signals, manifest, download."""
 
+from .cache import load_cached, read_cached
 from .download import fetch_alfa, processed_dir, resolve_alfa_dir
 from .errors import FAILURE_COLUMNS, AlfaDataError, MissingTopicError, failure_row
 from .flight import FAULT_CLASSES, Fault, Flight, Topic, find_flights, load_flight
@@ -26,7 +27,8 @@ from .signals import (
 __all__ = [
     "FAILURE_COLUMNS", "FAULT_CLASSES", "KINDS", "MAX_HOLD_S", "SIGNALS", "SUBSETS",
     "AlfaDataError", "Fault", "Flight", "MissingTopicError", "Sampled", "Signal", "Topic",
-    "build_manifest", "failure_row", "fetch_alfa", "find_flights", "load_flight",
+    "build_manifest", "failure_row", "fetch_alfa", "find_flights", "load_cached",
+    "load_flight",
     "name_subsets", "not_measured", "processed_dir", "read_manifest", "reads_actuators",
-    "resolve_alfa_dir", "sample", "scan_flights", "series", "subset_flights",
+    "read_cached", "resolve_alfa_dir", "sample", "scan_flights", "series", "subset_flights",
 ]

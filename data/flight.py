@@ -49,6 +49,7 @@ __all__ = [
     "Fault",
     "Flight",
     "Topic",
+    "assemble_flight",
     "find_flights",
     "load_flight",
     "parse_flight_name",
@@ -267,7 +268,7 @@ def load_flight(path: str | Path) -> Flight:
     """
     path = Path(path)
     name = path.name
-    meta = parse_flight_name(name)
+    parse_flight_name(name)      # a folder that is not an ALFA flight fails before any read
     prefix = f"{name}-"
     raw: dict[str, tuple] = {}
     repairs: list[str] = []
@@ -284,6 +285,18 @@ def load_flight(path: str | Path) -> Flight:
         topic: Topic(name, topic, file, (t_ns - t0) * 1e-9, frame, lines)
         for topic, (file, t_ns, frame, lines) in raw.items()
     }
+    return assemble_flight(path, t0, topics, repairs)
+
+
+def assemble_flight(path: str | Path, t0_ns: int, topics: dict[str, Topic],
+                    repairs=()) -> Flight:
+    """The :class:`Flight` of already-read ``topics`` (times on the clock of
+    ``t0_ns``), its ground truth read from them: what :func:`load_flight` returns
+    after parsing, and what the parsed-flight cache (:mod:`.cache`) and in-memory
+    injection (:mod:`.inject`) rebuild."""
+    path = Path(path)
+    name = path.name
+    meta = parse_flight_name(name)
     duration = max(float(tp.t[-1]) for tp in topics.values())
     label = str(meta["label"])
     return Flight(
@@ -292,7 +305,7 @@ def load_flight(path: str | Path) -> Flight:
         date=str(meta["date"]),
         label=label,
         emergency_trajectory=label.endswith("with_emr_traj"),
-        t0_ns=t0,
+        t0_ns=t0_ns,
         duration_s=duration,
         fault=_ground_truth(name, label, topics),
         topics=topics,

@@ -23,10 +23,20 @@ Ground truth is a ``failure_status-sensor`` topic with one row per corrupted row
 method and the scoring read it as they read ALFA's own ``failure_status`` topics.
 The new flight is named ``<source date-time>_<part>_sensor_<sensor>_<kind><100 m>
 _at<onset s>_failure``.
+
+The workflow builds these flights in memory (:func:`inject_flight`,
+:func:`injected_flights`) from the parsed source flights, whenever a job needs them: the
+same :class:`~.flight.Flight` that reading :func:`inject_sensor_fault`'s files gives,
+array for array (the two parsers agree on every cell of ALFA, and ``repr`` round-trips).
+The CSV copies are written only on request (``snakemake injected_csv``). An injected
+flight's checksum is the SHA-256 of its source's checksum and its fault spec
+(:func:`injected_sha256`).
 """
 
 from __future__ import annotations
 
+import hashlib
+import json
 import logging
 import os
 import shutil
@@ -34,14 +44,16 @@ import zlib
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from .errors import AlfaDataError
-from .flight import Flight, load_flight, parse_flight_name
+from .flight import Flight, Topic, assemble_flight, load_flight, parse_flight_name
 from .signals import SIGNALS, not_measured
 
 log = logging.getLogger("alfa_bench.data")
 
-__all__ = ["KINDS", "RAMP_S", "SENSORS", "inject_grid", "inject_sensor_fault", "injected_name"]
+__all__ = ["KINDS", "RAMP_S", "SENSORS", "grid_specs", "inject_flight", "inject_grid",
+           "inject_sensor_fault", "injected_flights", "injected_name", "injected_sha256"]
 
 #: The sensors a fault can be injected into: the measured signals.
 SENSORS = ("roll", "pitch", "yaw", "airspeed", "roll_rate", "pitch_rate", "yaw_rate")
@@ -83,24 +95,10 @@ def inject_sensor_fault(source: str | Path | Flight, processed: str | Path, sens
     seed : int
         Seeds the noise, with the new flight's name.
     """
-    if sensor not in SENSORS:
-        raise ValueError(f"sensor must be one of {SENSORS}, got {sensor!r}")
-    if kind not in KINDS:
-        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
     flight = source if isinstance(source, Flight) else load_flight(source)
-    source = flight.path
-    if flight.fault is None or flight.fault.fault_class != "none":
-        raise AlfaDataError("faults are injected into fault-free flights only",
-                            flight=flight.id)
+    topic = _check_spec(flight, sensor, kind, onset_s)
     sig = SIGNALS[sensor]
-    topic = flight.topic(sig.topic)
-    if not_measured(flight, [sensor]):
-        raise AlfaDataError(f"{sensor} is not measured on this flight (constant over all of "
-                            "it): a fault injected there would corrupt a value that is not "
-                            "there", flight=flight.id, file=topic.file, column=sig.column)
-    if not topic.t[0] < onset_s <= topic.t[-1]:
-        raise ValueError(f"onset {onset_s} s is outside {sig.topic} "
-                         f"({topic.t[0]:.2f}-{topic.t[-1]:.2f} s)")
+    source = flight.path
     name = injected_name(flight.id, sensor, kind, magnitude, onset_s)
     dest = Path(processed) / name
     dest.mkdir(parents=True)
@@ -120,19 +118,94 @@ def inject_sensor_fault(source: str | Path | Flight, processed: str | Path, sens
     return dest
 
 
-def inject_grid(processed: Path, manifest, out: Path, sensors, faults,
-                onsets) -> tuple[list[Path], list[dict]]:
-    """Every fault-free flight of ``manifest`` (under ``processed``) with every sensor
-    of ``sensors`` corrupted by every fault of ``faults`` (``{"kind", "magnitude"}``)
-    from every onset of ``onsets`` (fractions of the flight's duration); only the
-    topics of :data:`~.signals.SIGNALS` are written. A sensor whose topic a flight
-    lacks, or that the flight does not measure (the manifest's ``not_measured``), is
-    skipped there, with a warning. Returns the new folders, and the skipped
-    ``{"flight", "sensor", "reason"}``."""
-    topics = {s.topic for s in SIGNALS.values()}
-    written, skipped = [], []
+def _check_spec(flight: Flight, sensor: str, kind: str, onset_s: float) -> Topic:
+    """The sensor's topic, once the fault spec is checked against ``flight``."""
+    if sensor not in SENSORS:
+        raise ValueError(f"sensor must be one of {SENSORS}, got {sensor!r}")
+    if kind not in KINDS:
+        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
+    if flight.fault is None or flight.fault.fault_class != "none":
+        raise AlfaDataError("faults are injected into fault-free flights only",
+                            flight=flight.id)
+    sig = SIGNALS[sensor]
+    topic = flight.topic(sig.topic)
+    if not_measured(flight, [sensor]):
+        raise AlfaDataError(f"{sensor} is not measured on this flight (constant over all of "
+                            "it): a fault injected there would corrupt a value that is not "
+                            "there", flight=flight.id, file=topic.file, column=sig.column)
+    if not topic.t[0] < onset_s <= topic.t[-1]:
+        raise ValueError(f"onset {onset_s} s is outside {sig.topic} "
+                         f"({topic.t[0]:.2f}-{topic.t[-1]:.2f} s)")
+    return topic
+
+
+def inject_flight(source: Flight, processed: str | Path, sensor: str, kind: str,
+                  magnitude: float, onset_s: float, *, topics=None, seed: int = 0) -> Flight:
+    """The flight :func:`inject_sensor_fault` would write under ``processed``, built
+    in memory from the loaded ``source``; same parameters.
+
+    The kept topics are re-timed on the new flight's clock (its first record), as
+    reading the written files would; their frames are the source's, unchanged but
+    for the corrupted column, which becomes float64 as written by ``repr``.
+    """
+    topic = _check_spec(source, sensor, kind, onset_s)
+    sig = SIGNALS[sensor]
+    name = injected_name(source.id, sensor, kind, magnitude, onset_s)
+    keep = [t for t in source.topics if topics is None or t in topics or t == sig.topic]
+    # the record times in ns, exactly: |t| < 1e4 s keeps t * 1e9 within float64's integers
+    t_ns = {t: source.t0_ns + np.round(source.topics[t].t * 1e9).astype(np.int64)
+            for t in keep}
+    onset_ns = source.t0_ns + round(onset_s * 1e9)
+    values = topic.values(sig.column)
+    span = float(values.max() - values.min())
+    rng = np.random.default_rng([seed, zlib.crc32(name.encode())])
+    times = t_ns[sig.topic]
+    first = int(np.searchsorted(times, onset_ns))
+    corrupted = values.copy()
+    # the operations of _corrupt, in the same order on the same doubles, over the rows
+    corrupted[first:] = _corrupt(kind, values[first:], float(values[first - 1]),
+                                 (times[first:] - onset_ns) * 1e-9, magnitude, span, rng)
+    frame = topic.frame.copy(deep=False)
+    frame[sig.column] = corrupted
+    frames = {t: (frame if t == sig.topic else source.topics[t].frame) for t in keep}
+    gt = pd.DataFrame({"field.data": np.ones(len(times) - first, np.int64),
+                       "field.sensor": pd.Series([sensor] * (len(times) - first), dtype="str"),
+                       "field.kind": pd.Series([kind] * (len(times) - first), dtype="str"),
+                       "field.magnitude": np.full(len(times) - first, float(magnitude)),
+                       "field.source": pd.Series([source.id] * (len(times) - first),
+                                                 dtype="str")})
+    t_ns[GROUND_TRUTH], frames[GROUND_TRUTH] = times[first:], gt
+    lines = {t: source.topics[t].lines for t in keep}
+    lines[GROUND_TRUTH] = np.arange(2, len(times) - first + 2)
+    t0 = min(int(v[0]) for v in t_ns.values())
+    new = {t: Topic(name, t, f"{name}-{t}.csv", (t_ns[t] - t0) * 1e-9, frames[t], lines[t])
+           for t in sorted(t_ns)}
+    files = {source.topics[t].file: f"{name}-{t}.csv" for t in keep}
+    repairs = [files[r.split(":", 1)[0]] + ":" + r.split(":", 1)[1]
+               for r in source.repairs if r.split(":", 1)[0] in files]
+    return assemble_flight(Path(processed) / name, t0, new, repairs)
+
+
+def injected_sha256(source_sha256: str, sensor: str, kind: str, magnitude: float,
+                    onset_s: float) -> str:
+    """The checksum of an injected flight: its source's and its fault spec's."""
+    spec = {"source": source_sha256, "sensor": sensor, "kind": kind,
+            "magnitude": float(magnitude), "onset_s": float(onset_s)}
+    return hashlib.sha256(json.dumps(spec, sort_keys=True).encode()).hexdigest()
+
+
+def grid_specs(sources: dict[str, Flight], manifest, sensors, faults,
+               onsets) -> tuple[list[dict], list[dict]]:
+    """The fault specs of the grid: every fault-free flight of ``manifest`` (loaded in
+    ``sources``) with every sensor of ``sensors`` corrupted by every fault of ``faults``
+    (``{"kind", "magnitude"}``) from every onset of ``onsets`` (fractions of the
+    flight's duration). A sensor whose topic a flight lacks, or that the flight does not
+    measure (the manifest's ``not_measured``), is skipped there, with a warning.
+    Returns the specs (``source``, ``sensor``, ``kind``, ``magnitude``, ``onset_s``),
+    and the skipped ``{"flight", "sensor", "reason"}``."""
+    specs, skipped = [], []
     for row in manifest[manifest["fault_class"] == "none"].itertuples():
-        source = load_flight(Path(processed) / row.flight)
+        source = sources[row.flight]
         dead = set(str(row.not_measured).split(";"))
         for sensor in sensors:
             reason = (f"no {SIGNALS[sensor].topic} topic"
@@ -142,17 +215,49 @@ def inject_grid(processed: Path, manifest, out: Path, sensors, faults,
                 log.warning("%s: %s: %s, so no faults injected", row.flight, sensor, reason)
                 skipped.append({"flight": row.flight, "sensor": sensor, "reason": reason})
                 continue
-            for fault in faults:
-                for share in onsets:
-                    written.append(inject_sensor_fault(
-                        source, out, sensor, fault["kind"],
-                        float(fault["magnitude"]), round(share * row.flight_s, 2),
-                        topics=topics))
-        log.info("%s: sensor faults injected", row.flight)
+            specs += [{"source": row.flight, "sensor": sensor, "kind": fault["kind"],
+                       "magnitude": float(fault["magnitude"]),
+                       "onset_s": round(share * row.flight_s, 2)}
+                      for fault in faults for share in onsets]
+    return specs, skipped
+
+
+def injected_flights(sources: dict[str, Flight], manifest, processed: str | Path, sensors,
+                     faults, onsets) -> tuple[dict[str, tuple[Flight, str]], list[dict]]:
+    """The grid of :func:`grid_specs` built in memory (:func:`inject_flight`, only the
+    topics of :data:`~.signals.SIGNALS`): ``{name: (flight, sha256)}`` in grid order,
+    and the skipped pairs."""
+    topics = {s.topic for s in SIGNALS.values()}
+    sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
+    specs, skipped = grid_specs(sources, manifest, sensors, faults, onsets)
+    out = {}
+    for spec in specs:
+        flight = inject_flight(sources[spec["source"]], processed, spec["sensor"],
+                               spec["kind"], spec["magnitude"], spec["onset_s"], topics=topics)
+        out[flight.id] = flight, injected_sha256(sha[spec["source"]], spec["sensor"],
+                                                 spec["kind"], spec["magnitude"],
+                                                 spec["onset_s"])
+    return out, skipped
+
+
+def inject_grid(processed: Path, manifest, out: Path, sensors, faults,
+                onsets) -> tuple[list[Path], list[dict]]:
+    """The grid of :func:`grid_specs` over the flights under ``processed``, written as
+    ALFA-format folders under ``out`` (only the topics of :data:`~.signals.SIGNALS`):
+    the CSV copies of :func:`injected_flights`. Returns the new folders, and the
+    skipped pairs."""
+    topics = {s.topic for s in SIGNALS.values()}
+    sources = {name: load_flight(Path(processed) / name)
+               for name in manifest.loc[manifest["fault_class"] == "none", "flight"]}
+    specs, skipped = grid_specs(sources, manifest, sensors, faults, onsets)
+    written = [inject_sensor_fault(sources[spec["source"]], out, spec["sensor"],
+                                   spec["kind"], spec["magnitude"], spec["onset_s"],
+                                   topics=topics) for spec in specs]
     return written, skipped
 
 
 def _corrupt(kind, v, held, dt, m, span, rng):
+    """The corrupted value of a row (``v``, ``dt`` floats) or of many (arrays)."""
     match kind:
         case "stuck":
             return held
@@ -162,8 +267,8 @@ def _corrupt(kind, v, held, dt, m, span, rng):
             return v + m * span
         case "scale":
             return m * v
-        case "noise":
-            return v + rng.normal(0.0, m * span)
+        case "noise":       # one draw per row, in row order, for a row or for many
+            return v + rng.normal(0.0, m * span, size=np.shape(v) or None)
         case "ramp":
             return v + m * span * dt / RAMP_S
 

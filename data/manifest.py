@@ -30,12 +30,13 @@ from pathlib import Path
 import jsonschema
 import pandas as pd
 
+from .cache import cache_path, write_cached
 from .errors import FAILURE_COLUMNS, AlfaDataError, failure_row
 from .flight import Flight, find_flights, load_flight, parse_flight_name
 from .signals import not_measured
 
-__all__ = ["ICRA22_LAST_DATE", "SUBSETS", "build_manifest", "flight_sha256", "manifest_row",
-           "name_subsets", "read_manifest", "scan_flights", "subset_flights",
+__all__ = ["ICRA22_LAST_DATE", "SUBSETS", "build_manifest", "flight_sha256", "manifest_of",
+           "manifest_row", "name_subsets", "read_manifest", "scan_flights", "subset_flights",
            "validate_manifest"]
 
 log = logging.getLogger("alfa_bench.data")
@@ -69,8 +70,9 @@ def flight_sha256(path: Path) -> str:
     return h.hexdigest()
 
 
-def manifest_row(flight: Flight) -> dict:
-    """The manifest row of a loaded flight."""
+def manifest_row(flight: Flight, sha256: str | None = None) -> dict:
+    """The manifest row of a loaded flight; ``sha256`` stands for its files' checksum
+    where it has none on disk (an injected flight built in memory)."""
     fault = flight.fault
     onset = fault.onset_s if fault else None
     if fault is None:
@@ -94,7 +96,7 @@ def manifest_row(flight: Flight) -> dict:
         "pre_fault_s": pre,
         "n_topics": len(flight.topics),
         "repairs": len(flight.repairs),
-        "sha256": flight_sha256(flight.path),
+        "sha256": sha256 or flight_sha256(flight.path),
         "fault_sensor": (fault.sensor or "") if fault else "",
         "fault_kind": (fault.kind or "") if fault else "",
         "fault_magnitude": fault.magnitude if fault else None,
@@ -119,14 +121,24 @@ def name_subsets(flight: str) -> str:
     return ";".join(name for name, rule in SUBSETS.items() if rule(row))
 
 
-def scan_flights(processed: str | Path) -> tuple[pd.DataFrame, pd.DataFrame]:
+def _row(path: Path, cache: Path | None) -> dict:
+    flight = load_flight(path)
+    row = manifest_row(flight)
+    if cache is not None:
+        write_cached(flight, cache_path(cache, flight.id), row["sha256"])
+    return row
+
+
+def scan_flights(processed: str | Path, cache: str | Path | None = None
+                 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Load every flight under ``processed``: the validated manifest of those that
     load, and a failures table (:data:`~.errors.FAILURE_COLUMNS` and ``subsets``)
-    of those that do not, each also logged."""
+    of those that do not, each also logged. With ``cache``, each flight that loads is
+    also written there (:mod:`.cache`)."""
     rows, failures = [], []
     for path in find_flights(Path(processed)):
         try:
-            rows.append(manifest_row(load_flight(path)))
+            rows.append(_row(path, cache))
         except AlfaDataError as e:
             log.error("flight %s excluded: %s", path.name, e)
             failures.append({**failure_row(e, "load"), "flight": path.name,
@@ -134,22 +146,26 @@ def scan_flights(processed: str | Path) -> tuple[pd.DataFrame, pd.DataFrame]:
     if not rows:
         raise AlfaDataError(f"no readable flights under {processed} "
                             f"({len(failures)} could not be read)")
-    manifest = pd.DataFrame(rows, columns=COLUMNS)
-    validate_manifest(manifest)
-    return manifest, pd.DataFrame(failures, columns=[*FAILURE_COLUMNS, "subsets"])
+    return manifest_of(rows), pd.DataFrame(failures, columns=[*FAILURE_COLUMNS, "subsets"])
 
 
-def build_manifest(processed: str | Path, allow_empty: bool = False) -> pd.DataFrame:
-    """Load every flight under ``processed`` and return the validated manifest;
-    the first flight that cannot be read raises its :class:`AlfaDataError`. No flight
-    at all is an error too, unless ``allow_empty`` (the injected grid of a corpus
-    without fault-free flights)."""
-    rows = [manifest_row(load_flight(p)) for p in find_flights(Path(processed))]
-    if not rows and not allow_empty:
-        raise AlfaDataError(f"no flights found under {processed}")
+def manifest_of(rows: list[dict]) -> pd.DataFrame:
+    """The validated manifest of ``rows`` (:func:`manifest_row`); it may be empty."""
     manifest = pd.DataFrame(rows, columns=COLUMNS)
     validate_manifest(manifest)
     return manifest
+
+
+def build_manifest(processed: str | Path, allow_empty: bool = False,
+                   cache: str | Path | None = None) -> pd.DataFrame:
+    """Load every flight under ``processed`` and return the validated manifest;
+    the first flight that cannot be read raises its :class:`AlfaDataError`. No flight
+    at all is an error too, unless ``allow_empty`` (the injected grid of a corpus
+    without fault-free flights). With ``cache``, each flight is also written there."""
+    rows = [_row(p, cache) for p in find_flights(Path(processed))]
+    if not rows and not allow_empty:
+        raise AlfaDataError(f"no flights found under {processed}")
+    return manifest_of(rows)
 
 
 def validate_manifest(manifest: pd.DataFrame) -> None:

@@ -17,6 +17,8 @@ rule manifest:
     output:
         manifest="data/flights.csv",
         failures="data/load_failures.csv",
+        # every flight parsed once: what every later job reads (data/cache.py)
+        cache=directory("results/cache"),
     params:
         strict=config["strict"],
     log:

@@ -4,7 +4,7 @@ import json
 rule detect:
     input:
         manifest="data/flights.csv",
-        processed=PROCESSED,
+        cache="results/cache",
         code=lambda w: detector_code(w.method),
     output:
         detections=directory("results/detections/{method}"),
@@ -18,5 +18,7 @@ rule detect:
         "results/logs/detect/{method}.log",
     benchmark:
         "results/benchmarks/detect/{method}.tsv"
+    # before the injected jobs: the aggregates (sweep, figures, recordings) wait on these
+    priority: 1
     script:
         "../scripts/detect.py"

@@ -5,9 +5,8 @@
 rule inject:
     input:
         manifest="data/flights.csv",
-        processed=PROCESSED,
+        cache="results/cache",
     output:
-        processed=directory("results/injected/processed"),
         manifest="results/injected/flights.csv",
         # flight-sensor pairs left out: the sensor's topic is missing or not measured
         skipped="results/injected/skipped.csv",
@@ -19,35 +18,52 @@ rule inject:
         "../scripts/inject.py"
 
 
+# One job per method: each builds the injected flights in memory from the cached
+# fault-free flights (data/inject.py), so a changed method re-runs only its own job.
 rule detect_injected:
     input:
         manifest="results/injected/flights.csv",
-        processed="results/injected/processed",
         calibrate_on="data/flights.csv",
-        real=PROCESSED,
-        code=sorted({f for m in DETECTORS for f in detector_code(m)}),
+        cache="results/cache",
+        code=lambda w: detector_code(w.method),
     output:
-        detections=directory("results/injected/detections"),
-        traces=directory("results/injected/traces"),
+        detections=directory("results/injected/detections/{method}"),
+        traces=directory("results/injected/traces/{method}"),
     params:
         # canonical JSON: a changed value re-runs this job, a reordered key does not
-        methods=json.dumps({m: config["methods"][m] for m in DETECTORS}, sort_keys=True),
-        order=DETECTORS,
+        spec=lambda w: json.dumps(config["methods"][w.method], sort_keys=True),
+        injection=config["injection"],
         calibration=config["calibration"],
         strict=config["strict"],
     log:
-        "results/logs/detect_injected.log",
+        "results/logs/detect_injected/{method}.log",
     benchmark:
-        "results/benchmarks/detect_injected.tsv"
+        "results/benchmarks/detect_injected/{method}.tsv"
     script:
         "../scripts/detect_injected.py"
+
+
+# ALFA-format CSV copies of the injected flights, for use outside the pipeline; never
+# part of `all` (the workflow builds them in memory): `snakemake injected_csv`
+rule injected_csv:
+    input:
+        manifest="data/flights.csv",
+        processed=PROCESSED,
+    output:
+        processed=directory("results/injected/processed"),
+    params:
+        injection=config["injection"],
+    log:
+        "results/logs/injected_csv.log",
+    script:
+        "../scripts/injected_csv.py"
 
 
 rule detectability:
     input:
         manifest="results/injected/flights.csv",
         calibrate_on="data/flights.csv",
-        detections="results/injected/detections",
+        detections=expand("results/injected/detections/{method}", method=DETECTORS),
         clean=expand("results/detections/{method}", method=DETECTORS),
     output:
         csv=report("results/tables/detectability.csv", category="Sensor faults"),
@@ -68,8 +84,9 @@ rule isolation:
         injected="results/injected/flights.csv",
         detections=expand("results/detections/{method}", method=DETECTORS),
         traces=expand("results/traces/{method}", method=DETECTORS),
-        injected_detections="results/injected/detections",
-        injected_traces="results/injected/traces",
+        injected_detections=expand("results/injected/detections/{method}",
+                                   method=DETECTORS),
+        injected_traces=expand("results/injected/traces/{method}", method=DETECTORS),
     output:
         sensors_csv="results/tables/isolation_sensors.csv",
         sensors_md=report("results/tables/isolation_sensors.md", category="Sensor faults"),

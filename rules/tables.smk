@@ -76,7 +76,7 @@ rule deadline:
 rule leakage:
     input:
         manifest="data/flights.csv",
-        processed=PROCESSED,
+        cache="results/cache",
     output:
         csv="results/tables/leakage.csv",
         md=report("results/tables/leakage.md", category="Tables"),

@@ -1,24 +1,31 @@
-"""Snakemake script: every configured method on the injected flights, in one job (reading
-the flights costs more than scoring them), calibrated on the real flights only."""
+"""Snakemake script: one configured method on the injected flights, built in memory
+from the cached fault-free flights, and calibrated on the real flights only."""
 
 import json
 from pathlib import Path
 
 from alfa_bench.analysis.detections import write_detections
 from alfa_bench.analysis.logs import log_to
-from alfa_bench.data import load_flight, read_manifest
+from alfa_bench.data import AlfaDataError, load_cached, read_manifest
+from alfa_bench.data.inject import injected_flights
+from alfa_bench.methods import REGISTRY
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 manifest, real = read_manifest(sm.input.manifest), read_manifest(sm.input.calibrate_on)
-flights = {name: load_flight(Path(sm.input.processed) / name)
-           for name in manifest.loc[manifest["ground_truth"], "flight"]}
-flights |= {name: load_flight(Path(sm.input.real) / name)
-            for name in real.loc[real["ground_truth"], "flight"]}
-specs = json.loads(sm.params.methods)
-for method in sm.params.order:
-    write_detections(method, specs[method], flights, manifest, dict(sm.params.calibration),
-                     strict=sm.params.strict, config=sm.config,
-                     out=Path(sm.output.detections) / method,
-                     traces=Path(sm.output.traces) / method, calibrate_on=real,
-                     probes=False)    # isolation reads scores only
+grid = sm.params.injection
+sources = load_cached(sm.input.cache, real, real.loc[real["fault_class"] == "none", "flight"])
+built, _ = injected_flights(sources, real, "results/injected/processed", grid["sensors"],
+                            grid["faults"], grid["onsets"])
+sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
+if {name: s for name, (_, s) in built.items()} != sha:
+    raise AlfaDataError(f"{sm.input.manifest} is not the grid the config and the cached "
+                        "flights give: re-run the inject rule")
+spec = json.loads(sm.params.spec)
+flights = {name: flight for name, (flight, _) in built.items()}
+if REGISTRY[spec["detector"]].calibrated:            # fitted on the real flights only
+    flights |= load_cached(sm.input.cache, real)
+write_detections(sm.wildcards.method, spec, flights, manifest,
+                 dict(sm.params.calibration), strict=sm.params.strict, config=sm.config,
+                 out=Path(sm.output.detections), traces=Path(sm.output.traces),
+                 calibrate_on=real, probes=False)    # isolation reads scores only

@@ -16,8 +16,7 @@ sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 manifest = read_manifest(sm.input.manifest)
 real = read_manifest(sm.input.calibrate_on)
-folders = [Path(sm.input.detections) / m for m in sm.params.methods]
-table = detectability_table(read_records(folders), manifest,
+table = detectability_table(read_records(sm.input.detections), manifest,
                             read_records(sm.input.clean))
 table.to_csv(sm.output.csv, index=False)
 Path(sm.output.md).write_text(detectability_markdown(table))

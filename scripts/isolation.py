@@ -13,8 +13,7 @@ from alfa_bench.data import read_manifest
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 real, injected = read_manifest(sm.input.manifest), read_manifest(sm.input.injected)
-injected_runs = [[Path(d) / m for m in sm.params.methods]
-                 for d in (sm.input.injected_detections, sm.input.injected_traces)]
+injected_runs = [sm.input.injected_detections, sm.input.injected_traces]
 for records, traces, truth, csv, md in [
         (*injected_runs, "sensor",
          sm.output.sensors_csv, sm.output.sensors_md),

@@ -5,13 +5,12 @@ from pathlib import Path
 from alfa_bench.analysis.leakage import leakage_markdown, leakage_table
 from alfa_bench.analysis.logs import log_to
 from alfa_bench.analysis.provenance import run_provenance, stamp
-from alfa_bench.data import load_flight, read_manifest
+from alfa_bench.data import load_cached, read_manifest
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 manifest = read_manifest(sm.input.manifest)
-flights = {name: load_flight(Path(sm.input.processed) / name)
-           for name in manifest.loc[manifest["ground_truth"], "flight"]}
+flights = load_cached(sm.input.cache, manifest)
 table = leakage_table(flights)
 table.to_csv(sm.output.csv, index=False)
 Path(sm.output.md).write_text(leakage_markdown(table))

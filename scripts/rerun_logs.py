@@ -8,7 +8,8 @@ from alfa_bench.analysis.logs import log_to
 from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.analysis.rerun_log import write_rerun_log
 from alfa_bench.analysis.traces import read_traces
-from alfa_bench.data import load_flight, read_manifest
+from alfa_bench.data import read_cached, read_manifest
+from alfa_bench.data.cache import cache_path
 from alfa_bench.methods import make_detector
 
 sm = snakemake  # noqa: F821
@@ -20,10 +21,11 @@ detectors = [make_detector(spec["detector"], spec.get("params")) for spec in spe
 signals = list(dict.fromkeys(s for d in detectors for s in d.signals()))
 traces = read_traces(sm.input.traces)
 prov = run_provenance(sm.config, manifest)
+sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
 out = Path(sm.output[0])
 for flight in manifest.loc[manifest["ground_truth"], "flight"]:
     # a flight a method excluded is recorded without it
     mine = {m: traces[m, flight] for m in order if (m, flight) in traces}
-    write_rerun_log(load_flight(Path(sm.params.processed) / flight), mine, signals,
-                    out / f"{flight}.rrd", prov)
+    write_rerun_log(read_cached(cache_path(sm.input.cache, flight), sha[flight]), mine,
+                    signals, out / f"{flight}.rrd", prov)
     logging.info("%s: written", flight)

@@ -2,6 +2,8 @@
 its fault, not rerun's welcome screen. Skipped, with the reason, where Chromium or
 Playwright is missing (Debian: apt-get install chromium)."""
 
+import urllib.request
+
 import numpy as np
 import pytest
 
@@ -33,6 +35,8 @@ def test_the_recording_renders_open_on_the_fault(corpus, tmp_path):
     with serve_recording(rrd) as url:
         shown = screenshot(url, tmp_path / "viewer.png")
     assert shown.shows_recording, shown
+    with pytest.raises(OSError):     # the server is gone with its launcher, not left running
+        urllib.request.urlopen(url.split("?")[0], timeout=2)
     # the selected span is the fault's: from the onset to the end of the flight, on a
     # time panel from about 15 % of the width (right of the streams list) to the edge
     onset = flight.fault.onset_s / flight.duration_s

@@ -1,0 +1,17 @@
+"""Snakemake script: ALFA-format CSV copies of the injected sensor-fault flights."""
+
+import logging
+from pathlib import Path
+
+from alfa_bench.analysis.logs import log_to
+from alfa_bench.data import read_manifest
+from alfa_bench.data.inject import inject_grid
+
+sm = snakemake  # noqa: F821
+log_to(sm.log[0])
+grid = sm.params.injection
+Path(sm.output.processed).mkdir(parents=True, exist_ok=True)
+written, _ = inject_grid(Path(sm.input.processed), read_manifest(sm.input.manifest),
+                         Path(sm.output.processed), grid["sensors"], grid["faults"],
+                         grid["onsets"])
+logging.info("%d injected flights written", len(written))

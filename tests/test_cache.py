@@ -1,0 +1,80 @@
+"""The parsed-flight cache and the injected flights built in memory give exactly what
+parsing the CSVs gives: every array, frame, clock, fault and repair."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from alfa_bench.data import SIGNALS, AlfaDataError, load_flight, read_cached
+from alfa_bench.data.cache import write_cached
+from alfa_bench.data.inject import KINDS, inject_flight, inject_sensor_fault
+from alfa_bench.data.manifest import flight_sha256
+from alfa_bench.methods import make_detector, run_detector
+
+SOURCE = "carbonZ_2018-07-18-16-37-39_1_no_failure"
+
+
+def assert_same_flight(a, b):
+    assert (a.id, a.path, a.date, a.label, a.emergency_trajectory, a.t0_ns, a.duration_s,
+            a.fault, a.repairs) == (b.id, b.path, b.date, b.label, b.emergency_trajectory,
+                                    b.t0_ns, b.duration_s, b.fault, b.repairs)
+    assert list(a.topics) == list(b.topics)
+    for name, x in a.topics.items():
+        y = b.topics[name]
+        assert (x.flight, x.name, x.file) == (y.flight, y.name, y.file)
+        assert x.t.dtype == y.t.dtype and np.array_equal(x.t, y.t), name
+        assert np.array_equal(x.lines, y.lines), name
+        pd.testing.assert_frame_equal(x.frame, y.frame, check_exact=True)
+
+
+def test_a_cached_flight_is_the_parsed_flight(corpus, tmp_path):
+    for folder in sorted(corpus.iterdir()):
+        flight = load_flight(folder)
+        write_cached(flight, tmp_path / f"{flight.id}.npz", flight_sha256(folder))
+        assert_same_flight(read_cached(tmp_path / f"{flight.id}.npz", flight_sha256(folder)),
+                           flight)
+
+
+def test_repairs_and_text_columns_survive_the_cache(corpus, tmp_path):
+    """A flight with repaired rows and a text column with missing cells."""
+    folder = tmp_path / "processed" / SOURCE
+    folder.mkdir(parents=True)
+    for f in (corpus / SOURCE).iterdir():
+        (folder / f.name).write_bytes(f.read_bytes())
+    roll = folder / f"{SOURCE}-mavros-nav_info-roll.csv"
+    lines = roll.read_text().splitlines()
+    lines.insert(5, lines[5])                                   # a repeated %time
+    roll.write_text("\n".join(lines))                          # no final newline
+    times = [line.split(",")[0] for line in lines[1:6]]
+    modes = ["AUTO", "", "AUTO", "MANUAL", "AUTO"]                # a missing text cell
+    (folder / f"{SOURCE}-mavros-state.csv").write_text("%time,field.mode,field.armed\n" + "".join(
+        f"{t},{m},True\n" for t, m in zip(times, modes, strict=True)))
+    flight = load_flight(folder)
+    assert len(flight.repairs) == 2
+    state = flight.topic("mavros-state").frame
+    assert state["field.mode"].isna().sum() == 1 and state["field.armed"].dtype == bool
+    write_cached(flight, tmp_path / "c.npz", "0" * 64)
+    assert_same_flight(read_cached(tmp_path / "c.npz"), flight)
+
+
+def test_a_stale_cache_is_refused(corpus, tmp_path):
+    flight = load_flight(corpus / SOURCE)
+    write_cached(flight, tmp_path / "c.npz", "a" * 64)
+    with pytest.raises(AlfaDataError, match="re-run the manifest rule"):
+        read_cached(tmp_path / "c.npz", "b" * 64)
+
+
+@pytest.mark.parametrize("kind", KINDS)
+@pytest.mark.parametrize("sensor", ["roll", "pitch_rate"])
+def test_an_injected_flight_in_memory_is_its_csv_copy_read_back(corpus, tmp_path, kind,
+                                                                 sensor):
+    source = load_flight(corpus / SOURCE)
+    topics = {s.topic for s in SIGNALS.values()}
+    spec = (sensor, kind, 0.25, 40.0)
+    written = load_flight(inject_sensor_fault(source, tmp_path, *spec, topics=topics))
+    built = inject_flight(source, tmp_path, *spec, topics=topics)
+    assert_same_flight(built, written)
+    detector = make_detector("rls_arx_zscore", {"pairs": [
+        {"name": "roll", "input": "roll_cmd", "output": "roll"}]})
+    a, b = run_detector(detector, built), run_detector(detector, written)
+    assert np.array_equal(a.score, b.score, equal_nan=True)
