@@ -1,7 +1,6 @@
 """Leave-one-group-out folds: no flight is scored by a model or threshold that saw it.
 
-Each fold (scikit-learn's :class:`~sklearn.model_selection.LeaveOneGroupOut`) holds out
-one group of flights (a day, by default, since flights of one
+Each fold holds out one group of flights (a day, by default, since flights of one
 day share the aircraft's trim, wind and the segments of one recording) and
 calibrates on the fault-free data of every other flight with ground truth.
 """
@@ -9,7 +8,6 @@ calibrates on the fault-free data of every other flight with ground truth.
 from __future__ import annotations
 
 import pandas as pd
-from sklearn.model_selection import LeaveOneGroupOut
 
 __all__ = ["GROUPINGS", "folds"]
 
@@ -29,7 +27,7 @@ def folds(manifest: pd.DataFrame, group_by: str) -> dict[str, tuple[list[str], l
         raise ValueError(f"calibration needs flights from at least two {group_by} groups; "
                          f"found {found}")
     flights = labelled["flight"].to_numpy()
-    out = {}
-    for train, test in LeaveOneGroupOut().split(flights, groups=groups):
-        out[groups[test[0]]] = (flights[test].tolist(), flights[train].tolist())
-    return {g: out[g] for g in dict.fromkeys(groups)}            # in manifest order
+    # in manifest order (scikit-learn's LeaveOneGroupOut gives the same folds, but every
+    # job that calibrates would pay its import, ~0.7 s, for these three lines)
+    return {g: (flights[groups == g].tolist(), flights[groups != g].tolist())
+            for g in dict.fromkeys(groups)}

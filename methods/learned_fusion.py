@@ -40,7 +40,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from sklearn.mixture import GaussianMixture
 
 from alfa_bench.data import Sampled
 
@@ -132,6 +131,9 @@ class LearnedFusion(Detector):
             raise ValueError("learned fusion: no fault-free segment is long enough to "
                              f"score ({self.window_s + self.baseline_s} s)")
         rows = rows[::self.thin]
+        # imported here: every job imports the registry, only this method needs it
+        from sklearn.mixture import GaussianMixture
+
         fits = [GaussianMixture(k, random_state=self.random_state).fit(rows)
                 for k in range(1, self.max_components + 1)]
         self.bic_ = [float(m.bic(rows)) for m in fits]

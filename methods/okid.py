@@ -36,7 +36,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import control
 import numpy as np
 
 __all__ = ["OkidModel", "observer_markov", "okid", "system_markov"]
@@ -115,6 +114,9 @@ def okid(segments: list[tuple[np.ndarray, np.ndarray]], lags: int, order: int) -
     yy = np.zeros((q, m + q, 2 * lags + 2))               # [D, 0], [Y_1, Yo_1], ...
     yy[:, :m, 0] = D
     yy[:, :, 1:] = np.concatenate([Y, Yo], axis=2).transpose(1, 2, 0)
+    # imported here: python-control brings matplotlib (~0.5 s), which only OKID fits need
+    import control
+
     sys, sv = control.eigensys_realization(yy, order, m=lags, n=lags)
     return OkidModel(A=np.asarray(sys.A), B=np.asarray(sys.B)[:, :m], C=np.asarray(sys.C),
                      D=D, L=np.asarray(sys.B)[:, m:], hankel_sv=np.asarray(sv))
