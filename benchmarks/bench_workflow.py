@@ -31,12 +31,14 @@ _TIME = re.compile(r"^(carbonZ_\d{4}-\d{2}-\d{2}-)(\d{2})(-\d{2}-\d{2}.*)$")
 
 def replicate(processed: Path, dest: Path, copies: int) -> int:
     """Symlink every flight of ``processed`` ``copies`` times into ``dest``; copy r moves
-    the recording hour by 10 r (names stay distinct and parseable)."""
+    the recording hour by r. The hour keeps two digits up to 99 (ALFA's flights are
+    recorded from 11 to 17 h), so names stay parseable; a clash with another flight's
+    name is an error."""
     n = 0
     for flight in sorted(p for p in processed.iterdir() if p.is_dir()):
         for r in range(copies):
             m = _TIME.match(flight.name)
-            name = f"{m[1]}{int(m[2]) + 10 * r:02d}{m[3]}"
+            name = f"{m[1]}{int(m[2]) + r:02d}{m[3]}"
             folder = dest / name
             folder.mkdir(parents=True)
             for f in flight.iterdir():
