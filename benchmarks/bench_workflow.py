@@ -52,8 +52,10 @@ def run(alfa: Path, config: Path, work: Path) -> float:
            "--snakefile", str(ROOT / "Snakefile"), "--directory", str(work),
            "--configfile", str(config)]
     t = time.perf_counter()
-    subprocess.run(cmd, env={**os.environ, "ALFA_DIR": str(alfa)}, check=True,
-                   capture_output=True)
+    done = subprocess.run(cmd, env={**os.environ, "ALFA_DIR": str(alfa)},
+                          capture_output=True, text=True)
+    if done.returncode:       # the working directory, logs and all, goes with the run
+        sys.exit(f"snakemake failed in {work}:\n{done.stderr[-5000:]}")
     return time.perf_counter() - t
 
 
