@@ -2,6 +2,10 @@
 # scored by every method, calibrated on the real flights only.
 
 
+# where `snakemake injected_csv` writes the injected flights, and so their folder name
+INJECTED_PROCESSED = "results/injected/processed"
+
+
 rule inject:
     input:
         manifest="data/flights.csv",
@@ -12,6 +16,7 @@ rule inject:
         skipped="results/injected/skipped.csv",
     params:
         injection=config["injection"],
+        processed=INJECTED_PROCESSED,
     log:
         "results/logs/inject.log",
     script:
@@ -33,6 +38,7 @@ rule detect_injected:
         # canonical JSON: a changed value re-runs this job, a reordered key does not
         spec=lambda w: json.dumps(config["methods"][w.method], sort_keys=True),
         injection=config["injection"],
+        processed=INJECTED_PROCESSED,
         calibration=config["calibration"],
         strict=config["strict"],
     log:
@@ -50,7 +56,7 @@ rule injected_csv:
         manifest="data/flights.csv",
         processed=PROCESSED,
     output:
-        processed=directory("results/injected/processed"),
+        processed=directory(INJECTED_PROCESSED),
     params:
         injection=config["injection"],
     log:

@@ -14,17 +14,20 @@ sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 manifest, real = read_manifest(sm.input.manifest), read_manifest(sm.input.calibrate_on)
 grid = sm.params.injection
-sources = load_cached(sm.input.cache, real, real.loc[real["fault_class"] == "none", "flight"])
-built, _ = injected_flights(sources, real, "results/injected/processed", grid["sensors"],
-                            grid["faults"], grid["onsets"])
+spec = json.loads(sm.params.spec)
+calibrated = REGISTRY[spec["detector"]].calibrated     # fitted on the real flights only
+free = real.loc[real["fault_class"] == "none", "flight"]
+loaded = load_cached(sm.input.cache, real, None if calibrated else free)
+built, _ = injected_flights({name: loaded[name] for name in free}, real,
+                            sm.params.processed, grid["sensors"], grid["faults"],
+                            grid["onsets"])
 sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
 if {name: s for name, (_, s) in built.items()} != sha:
     raise AlfaDataError(f"{sm.input.manifest} is not the grid the config and the cached "
                         "flights give: re-run the inject rule")
-spec = json.loads(sm.params.spec)
 flights = {name: flight for name, (flight, _) in built.items()}
-if REGISTRY[spec["detector"]].calibrated:            # fitted on the real flights only
-    flights |= load_cached(sm.input.cache, real)
+if calibrated:
+    flights |= loaded
 write_detections(sm.wildcards.method, spec, flights, manifest,
                  dict(sm.params.calibration), strict=sm.params.strict, config=sm.config,
                  out=Path(sm.output.detections), traces=Path(sm.output.traces),

@@ -17,7 +17,7 @@ grid = sm.params.injection
 manifest = read_manifest(sm.input.manifest)
 sources = load_cached(sm.input.cache, manifest,
                       manifest.loc[manifest["fault_class"] == "none", "flight"])
-flights, skipped = injected_flights(sources, manifest, "results/injected/processed",
+flights, skipped = injected_flights(sources, manifest, sm.params.processed,
                                     grid["sensors"], grid["faults"], grid["onsets"])
 logging.info("%d injected flights; %d flight-sensor pairs skipped", len(flights),
              len(skipped))
