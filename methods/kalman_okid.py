@@ -32,8 +32,9 @@ deadbeat-like observer has forgotten its zero initial state.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-from filterpy.kalman import KalmanFilter
 
 from alfa_bench.data import Sampled
 
@@ -41,6 +42,9 @@ from . import kernels
 from .base import Detector
 from .glrt import empirical_threshold
 from .okid import OkidModel, okid
+
+if TYPE_CHECKING:
+    from filterpy.kalman import KalmanFilter
 
 __all__ = ["KalmanOkid"]
 
@@ -153,6 +157,9 @@ class KalmanOkid(Detector):
 
     @staticmethod
     def _filter(m: OkidModel) -> KalmanFilter:
+        # filterpy imports scipy.stats (~0.5 s): only where a filter is made
+        from filterpy.kalman import KalmanFilter
+
         kf = KalmanFilter(dim_x=m.A.shape[0], dim_z=1, dim_u=m.B.shape[1])
         kf.F, kf.B, kf.H = m.A, m.B, m.C
         kf.K = np.linalg.solve(m.A, m.L)                   # L = A K

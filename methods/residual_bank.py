@@ -89,7 +89,6 @@ import re
 from functools import cache
 
 import numpy as np
-from scipy import stats
 
 from alfa_bench.data import SIGNALS, Sampled
 
@@ -139,6 +138,8 @@ def window_steps(seconds: float, rate_hz: float) -> int:
 def gumbel_threshold(maxima: np.ndarray, level: float) -> float:
     """The ``level`` quantile of a Gumbel law fitted (maximum likelihood) to the
     per-flight ``maxima``."""
+    from scipy import stats  # ~0.5 s to import: only where a Gumbel law is fitted
+
     loc, scale = stats.gumbel_r.fit(np.asarray(maxima, dtype=float))
     return float(stats.gumbel_r.ppf(level, loc, scale))
 
