@@ -40,6 +40,7 @@ from alfa_bench.methods import (
 )
 
 from .calibration import GROUPINGS, folds
+from .isolation import isolate
 from .provenance import provenance, read_table, run_provenance, stamp
 from .scoring import flight_outcome
 from .traces import write_trace
@@ -160,6 +161,7 @@ def detection_record(method: str, spec: dict, detector: Detector, flight: Flight
     trace = run_detector(detector, flight, probes=probes)
     onset = flight.fault.onset_s
     first = trace.first_alarm_s()
+    outputs = dict(zip(trace.channels, detector.channel_outputs(), strict=True))
     outcome = flight_outcome(onset, first)
     return {
         "flight": flight.id,
@@ -183,7 +185,9 @@ def detection_record(method: str, spec: dict, detector: Detector, flight: Flight
                                for i, ch in enumerate(trace.channels)},
         "pair_armed_s": {ch: trace.armed_s(i) for i, ch in enumerate(trace.channels)},
         "skipped_channels": trace.skipped,
-        "channel_outputs": dict(zip(trace.channels, detector.channel_outputs(), strict=True)),
+        "channel_outputs": outputs,
+        # the sensor the first alarm from the onset points at (isolation.py), or "missed"
+        "isolated_sensor": None if onset is None else isolate(trace, onset, outputs),
         "grid": {"rate_hz": detector.rate_hz, "samples": int(trace.t.size),
                  "start_s": float(trace.t[0]), "stop_s": float(trace.t[-1])},
         "repairs": list(flight.repairs),
@@ -214,18 +218,21 @@ def read_failures(folders) -> list[pd.DataFrame]:
 
 
 def write_detections(method: str, spec: dict, flights: dict[str, Flight], manifest: pd.DataFrame,
-                     calibration: dict, *, strict: bool, config: dict, out: Path, traces: Path,
-                     calibrate_on: pd.DataFrame | None = None, probes: bool = True) -> None:
+                     calibration: dict, *, strict: bool, config: dict, out: Path,
+                     traces: Path | None, calibrate_on: pd.DataFrame | None = None,
+                     probes: bool = True) -> None:
     """Run :func:`detect_all` and write ``out/<flight>.json``, ``traces/<flight>.npz``
-    and ``out/failures.csv`` (the flights excluded, empty when ``strict``, which
-    raises instead), each with its provenance."""
-    out.mkdir(parents=True, exist_ok=True)
-    traces.mkdir(parents=True, exist_ok=True)
+    (unless ``traces`` is None) and ``out/failures.csv`` (the flights excluded, empty
+    when ``strict``, which raises instead), each with its provenance."""
+    for folder in (out, traces):
+        if folder is not None:
+            folder.mkdir(parents=True, exist_ok=True)
     failures = None if strict else []
     for record, trace in detect_all(method, spec, flights, manifest, calibration, failures,
                                     calibrate_on, probes):
         write_record(record, out / f"{record['flight']}.json")
-        write_trace(trace, traces / f"{record['flight']}.npz", record["provenance"])
+        if traces is not None:
+            write_trace(trace, traces / f"{record['flight']}.npz", record["provenance"])
         log.info("%s %s: %s, first alarm %s", method, record["flight"], record["outcome"],
                  record["first_alarm_s"])
     pd.DataFrame(failures or [], columns=FAILURE_COLUMNS).to_csv(out / "failures.csv",

@@ -51,15 +51,19 @@ def measured_sensor(signal: str) -> str:
     raise KeyError(f"signal {signal!r} reads no sensor")
 
 
-def isolate(trace: Trace, onset_s: float, outputs: dict[str, str]) -> str:
+def isolate(trace: Trace, onset_s: float, outputs: dict[str, str]) -> str | None:
     """The sensor that ``trace`` isolates for a fault from ``onset_s``, or
-    :data:`MISSED`; ``outputs`` maps each channel to the signal it scores."""
+    :data:`MISSED`; ``outputs`` maps each channel to the signal it scores. None if
+    the alarming channel scores no sensor (the emulation oracle's servo outputs)."""
     alarmed = trace.alarm.any(axis=1) & (trace.t >= onset_s)
     if not alarmed.any():
         return MISSED
     k = int(np.argmax(alarmed))
     r = np.where(trace.alarm[k], _ratio_row(trace, k), -np.inf)
-    return measured_sensor(outputs[trace.channels[int(np.argmax(r))]])
+    try:
+        return measured_sensor(outputs[trace.channels[int(np.argmax(r))]])
+    except KeyError:
+        return None
 
 
 def _ratio_row(trace: Trace, k: int) -> np.ndarray:
@@ -68,16 +72,18 @@ def _ratio_row(trace: Trace, k: int) -> np.ndarray:
         return trace.score[k] / trace.threshold
 
 
-def isolation_rows(records: list[dict], traces: dict[tuple[str, str], Trace],
-                   truth: str) -> pd.DataFrame:
+def isolation_rows(records: list[dict], truth: str) -> pd.DataFrame:
     """Per record of a faulty flight: method, flight, the ``true`` sensor (``truth=
     "sensor"``, from ``fault_sensor``) or actuator class (``truth="actuator"``), and
-    the ``predicted`` one."""
+    the ``predicted`` one, from the record's ``isolated_sensor`` (:func:`isolate`)."""
     rows = []
     for r in records:
         if r["fault_class"] == "none" or r["onset_s"] is None:
             continue
-        sensor = isolate(traces[r["method"], r["flight"]], r["onset_s"], r["channel_outputs"])
+        sensor = r["isolated_sensor"]
+        if sensor is None:
+            raise ValueError(f"{r['method']} on {r['flight']}: its alarm scores no sensor, "
+                             "so it cannot be scored for isolation")
         if truth == "sensor":
             true, predicted = r["fault_sensor"], sensor
         else:

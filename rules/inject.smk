@@ -33,7 +33,6 @@ rule detect_injected:
         code=lambda w: detector_code(w.method),
     output:
         detections=directory("results/injected/detections/{method}"),
-        traces=directory("results/injected/traces/{method}"),
     params:
         # canonical JSON: a changed value re-runs this job, a reordered key does not
         spec=lambda w: json.dumps(config["methods"][w.method], sort_keys=True),
@@ -89,10 +88,8 @@ rule isolation:
         manifest="data/flights.csv",
         injected="results/injected/flights.csv",
         detections=expand("results/detections/{method}", method=DETECTORS),
-        traces=expand("results/traces/{method}", method=DETECTORS),
         injected_detections=expand("results/injected/detections/{method}",
                                    method=DETECTORS),
-        injected_traces=expand("results/injected/traces/{method}", method=DETECTORS),
     output:
         sensors_csv="results/tables/isolation_sensors.csv",
         sensors_md=report("results/tables/isolation_sensors.md", category="Sensor faults"),

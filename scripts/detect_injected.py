@@ -30,5 +30,5 @@ if calibrated:
     flights |= loaded
 write_detections(sm.wildcards.method, spec, flights, manifest,
                  dict(sm.params.calibration), strict=sm.params.strict, config=sm.config,
-                 out=Path(sm.output.detections), traces=Path(sm.output.traces),
-                 calibrate_on=real, probes=False)    # isolation reads scores only
+                 out=Path(sm.output.detections), traces=None, calibrate_on=real,
+                 probes=False)    # the records hold all that is read of these runs

@@ -7,19 +7,15 @@ from alfa_bench.analysis import read_records
 from alfa_bench.analysis.isolation import isolation_markdown, isolation_rows
 from alfa_bench.analysis.logs import log_to
 from alfa_bench.analysis.provenance import run_provenance, stamp
-from alfa_bench.analysis.traces import read_traces
 from alfa_bench.data import read_manifest
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 real, injected = read_manifest(sm.input.manifest), read_manifest(sm.input.injected)
-injected_runs = [sm.input.injected_detections, sm.input.injected_traces]
-for records, traces, truth, csv, md in [
-        (*injected_runs, "sensor",
-         sm.output.sensors_csv, sm.output.sensors_md),
-        (sm.input.detections, sm.input.traces, "actuator",
-         sm.output.actuators_csv, sm.output.actuators_md)]:
-    rows = isolation_rows(read_records(records), read_traces(traces), truth)
+for records, truth, csv, md in [
+        (sm.input.injected_detections, "sensor", sm.output.sensors_csv, sm.output.sensors_md),
+        (sm.input.detections, "actuator", sm.output.actuators_csv, sm.output.actuators_md)]:
+    rows = isolation_rows(read_records(records), truth)
     rows.to_csv(csv, index=False)
     Path(md).write_text(isolation_markdown(rows, truth))
     prov = (run_provenance(sm.config, injected, real) if truth == "sensor"

@@ -74,6 +74,17 @@ def test_the_rls_arx_pairs_name_the_faulty_sensor(corpus, tmp_path, sensor):
     assert isolate(trace, flight.fault.onset_s, outputs) == sensor
 
 
+def test_an_alarm_on_no_sensor_isolates_nothing_and_cannot_be_scored():
+    t = np.arange(3.0)
+    trace = Trace(t=t, score=np.full((3, 1), 2.0), alarm=np.ones((3, 1), bool),
+                  channels=("servo",), threshold=np.ones(1))
+    assert isolate(trace, 1.0, {"servo": "servo_rudder"}) is None
+    record = {"method": "oracle", "flight": "f", "fault_class": "rudder", "onset_s": 1.0,
+              "fault_sensor": None, "isolated_sensor": None}
+    with pytest.raises(ValueError, match="oracle on f: its alarm scores no sensor"):
+        isolation_rows([record], truth="actuator")
+
+
 def test_a_signal_names_the_sensor_it_reads():
     assert measured_sensor("roll_error") == "roll" and measured_sensor("pitch") == "pitch"
     assert measured_sensor("roll_rate") == "roll_rate"
@@ -84,19 +95,18 @@ def test_a_signal_names_the_sensor_it_reads():
 
 
 def test_confusion_counts_true_against_predicted():
-    records = [{"method": "m", "flight": f"f{i}", "fault_class": "aileron", "onset_s": 1.0,
-                "fault_sensor": None} for i in range(3)]
     t = np.arange(5.0)
 
-    def trace(k, channel):
+    def record(i, k, channel):
         score = np.zeros((5, 2))
         score[k:, channel] = 2.0
-        return Trace(t=t, score=score, alarm=score > 1.0, channels=("a", "b"),
-                     threshold=np.ones(2))
-    traces = {("m", "f0"): trace(2, 0), ("m", "f1"): trace(3, 1), ("m", "f2"): trace(5, 0)}
-    for r in records:
-        r["channel_outputs"] = {"a": "roll", "b": "pitch"}
-    rows = isolation_rows(records, traces, truth="actuator")
+        trace = Trace(t=t, score=score, alarm=score > 1.0, channels=("a", "b"),
+                      threshold=np.ones(2))
+        outputs = {"a": "roll", "b": "pitch"}
+        return {"method": "m", "flight": f"f{i}", "fault_class": "aileron", "onset_s": 1.0,
+                "fault_sensor": None, "isolated_sensor": isolate(trace, 1.0, outputs)}
+    records = [record(0, 2, 0), record(1, 3, 1), record(2, 5, 0)]
+    rows = isolation_rows(records, truth="actuator")
     assert rows["predicted"].tolist() == ["aileron", "elevator", MISSED]
     assert rows["correct"].tolist() == [True, False, False]
     table = confusion(rows, ["engine", "aileron", "elevator", "rudder"])["m"]

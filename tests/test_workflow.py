@@ -92,7 +92,8 @@ def test_outputs_and_their_contents(runs, corpus):
         r = json.loads(records[0].read_text())
         assert {"flight", "method", "parameters", "onset_s", "first_alarm_s", "alarm_intervals",
                 "pair_first_alarm_s", "pair_armed_s", "outcome", "provenance", "role",
-                "reads_actuators", "signal_kinds", "skipped_channels"} <= set(r)
+                "reads_actuators", "signal_kinds", "skipped_channels",
+                "isolated_sensor"} <= set(r)
         assert r["provenance"]["inputs"]["flight_sha256"]
     assert "Keipour et al. ICRA 2019 (paper)" in (out / "tables/summary.md").read_text()
     comparison = read_table(out / "tables/comparison.csv")
