@@ -4,7 +4,7 @@
   of fault-free flight) and mean detection time against false alarms per hour, every
   method on one set of axes, the configured operating point marked.
 - :func:`detection_time_figure`: per method, detection times by fault class.
-- :func:`flight_figure`: per flight, one small panel per method of its score-to-
+- :class:`FlightFigure`: per flight, one small panel per method of its score-to-
   threshold ratio around the onset.
 
 PNG output is deterministic for a given matplotlib version (no dates are written).
@@ -20,13 +20,14 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
+from matplotlib.ticker import FixedLocator, NullLocator  # noqa: E402
 
 from alfa_bench.methods import Trace  # noqa: E402
 
 from .sweep import ratio  # noqa: E402
 from .tables import FAULT_ORDER  # noqa: E402
 
-__all__ = ["BLOCK_STYLES", "colors", "detection_time_figure", "flight_figure", "save",
+__all__ = ["BLOCK_STYLES", "FlightFigure", "colors", "detection_time_figure", "save",
            "sweep_figure"]
 
 _DPI = 110
@@ -126,39 +127,71 @@ def detection_time_figure(records: list[dict], flights: list[str], path: str | P
     save(fig, path)
 
 
-def flight_figure(flight: str, onset_s: float | None, end_s: float | None,
-                  traces: dict[str, Trace], path: str | Path, window_s: float = 30.0) -> None:
-    """One panel per method: :math:`\\max_c s_c/\\gamma_c` against the threshold 1,
-    within ``window_s`` of the onset (the whole flight if fault-free)."""
-    methods = list(traces)
-    height = 1.25 * len(methods) + 0.8
-    fig, axes = plt.subplots(len(methods), 1, figsize=(8, height), sharex=True,
-                             squeeze=False)
-    # fixed margins (in inches): a constrained layout of this many axes took most of
-    # the drawing time
-    fig.subplots_adjust(left=0.2, right=0.98, bottom=0.45 / height, top=1 - 0.75 / height,
-                        hspace=0.12)
-    for ax, m in zip(axes[:, 0], methods, strict=True):
-        tr = traces[m]
-        r = ratio(tr)
-        lo, hi = ((tr.t[0], tr.t[-1]) if onset_s is None
-                  else (onset_s - window_s, min(onset_s + window_s, tr.t[-1])))
-        sel = (tr.t >= lo) & (tr.t <= hi) & np.isfinite(r)
-        ax.plot(tr.t[sel], np.clip(r[sel], 1e-2, 1e4), lw=0.9, color="tab:blue")
-        ax.axhline(1.0, color="tab:red", lw=0.9, ls="--")
-        if onset_s is not None:
-            ax.axvspan(onset_s, min(hi, end_s if end_s is not None else hi), color="0.85")
-        first = tr.first_alarm_s()
-        if first is not None and lo <= first <= hi:
-            ax.axvline(first, color="tab:red", lw=1.2)
-        note = "no alarm" if first is None else f"first alarm {first:.1f} s"
-        ax.text(0.005, 0.95, note, transform=ax.transAxes, fontsize=7, va="top")
-        ax.set_yscale("log")
-        ax.set_ylim(1e-2, 1e4)
-        ax.set_xlim(lo, hi)
-        ax.set_ylabel(m, fontsize=7, rotation=0, ha="right", va="center")
-        ax.tick_params(labelsize=7)
-    axes[-1, 0].set_xlabel("flight time (s)")
-    fig.suptitle(f"{flight}\nscore / threshold (dashed: alarm level; grey: fault; "
-                 "red line: first alarm)", fontsize=9)
-    save(fig, path)
+class FlightFigure:
+    """Per flight, one panel per method of ``methods``: :math:`\\max_c s_c/\\gamma_c`
+    against the threshold 1, within ``window_s`` of the onset (the whole flight if
+    fault-free).
+
+    The figure is laid out once and redrawn per flight: making its axes and ticks
+    took half of each figure's time. Call :meth:`close` when done.
+    """
+
+    def __init__(self, methods: list[str], window_s: float = 30.0):
+        self.methods = list(methods)
+        self.window_s = window_s
+        height = 1.25 * len(self.methods) + 0.8
+        self.fig, axes = plt.subplots(len(self.methods), 1, figsize=(8, height), sharex=True,
+                                      squeeze=False)
+        # fixed margins (in inches): a constrained layout of this many axes took most
+        # of the drawing time
+        self.fig.subplots_adjust(left=0.2, right=0.98, bottom=0.45 / height,
+                                 top=1 - 0.75 / height, hspace=0.12)
+        self.panels = []
+        for ax, m in zip(axes[:, 0], self.methods, strict=True):
+            ax.axhline(1.0, color="tab:red", lw=0.9, ls="--")
+            ax.set_yscale("log")
+            ax.set_ylim(1e-2, 1e4)
+            # fixed decades, no minor ticks: the log locators took much of the drawing
+            ax.yaxis.set_major_locator(FixedLocator([1e-2, 1e0, 1e2, 1e4]))
+            ax.yaxis.set_minor_locator(NullLocator())
+            ax.set_ylabel(m, fontsize=7, rotation=0, ha="right", va="center")
+            ax.tick_params(labelsize=7)
+            self.panels.append({
+                "ax": ax,
+                "score": ax.plot([], [], lw=0.9, color="tab:blue")[0],
+                "fault": ax.axvspan(0.0, 1.0, color="0.85"),
+                "first": ax.axvline(0.0, color="tab:red", lw=1.2),
+                "note": ax.text(0.005, 0.95, "", transform=ax.transAxes, fontsize=7,
+                                va="top")})
+        axes[-1, 0].set_xlabel("flight time (s)")
+        self.title = self.fig.suptitle("", fontsize=9)
+
+    def draw(self, flight: str, onset_s: float | None, end_s: float | None,
+             traces: dict[str, Trace], path: str | Path) -> None:
+        """Draw ``traces`` (one per method, in order) of ``flight`` and write ``path``."""
+        if list(traces) != self.methods:
+            raise ValueError(f"{flight}: traces of {list(traces)}, the figure has panels "
+                             f"for {self.methods}")
+        for panel, tr in zip(self.panels, traces.values(), strict=True):
+            r = ratio(tr)
+            lo, hi = ((tr.t[0], tr.t[-1]) if onset_s is None
+                      else (onset_s - self.window_s, min(onset_s + self.window_s, tr.t[-1])))
+            sel = (tr.t >= lo) & (tr.t <= hi) & np.isfinite(r)
+            panel["score"].set_data(tr.t[sel], np.clip(r[sel], 1e-2, 1e4))
+            fault = panel["fault"]
+            fault.set_visible(onset_s is not None)
+            if onset_s is not None:
+                fault.set_x(onset_s)
+                fault.set_width(min(hi, end_s if end_s is not None else hi) - onset_s)
+            first = tr.first_alarm_s()
+            panel["first"].set_visible(first is not None and lo <= first <= hi)
+            panel["first"].set_xdata([first, first])
+            panel["note"].set_text("no alarm" if first is None else f"first alarm {first:.1f} s")
+            panel["ax"].set_xlim(lo, hi)
+        self.title.set_text(f"{flight}\nscore / threshold (dashed: alarm level; grey: "
+                            "fault; red line: first alarm)")
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        self.fig.savefig(path, dpi=_DPI, metadata=_METADATA)
+
+    def close(self) -> None:
+        plt.close(self.fig)
