@@ -3,6 +3,7 @@ one flight must not show in the next."""
 
 import numpy as np
 import pytest
+
 from alfa_bench.analysis.figures import FlightFigure
 from alfa_bench.methods import Trace
 
