@@ -23,6 +23,7 @@ from __future__ import annotations
 import io
 import json
 import zipfile
+from functools import cache, partial
 from pathlib import Path
 
 import numpy as np
@@ -97,25 +98,45 @@ def read_cached(path: str | Path, sha256: str | None = None) -> Flight:
             raise AlfaDataError(f"the parsed-flight cache {path} is of files with SHA-256 "
                                 f"{meta['sha256']}, the manifest says {sha256}: re-run "
                                 "the manifest rule", flight=meta["flight"])
-        topics = {}
-        for i, spec in enumerate(meta["topics"]):
-            t = z[f"{i}/t"]
-            topics[spec["name"]] = Topic(meta["flight"], spec["name"], spec["file"], t,
-                                         _frame(z, i, spec["columns"], len(t)),
-                                         z[f"{i}/lines"])
+        arrays = {key: z[key] for key in z.files if key != "meta"}
+    topics = {}
+    for i, spec in enumerate(meta["topics"]):
+        t, columns = arrays[f"{i}/t"], spec["columns"]
+        # the frame is built when first needed, once (cache), for all copies of the topic
+        frame = cache(partial(_frame, arrays, i, columns, len(t)))
+        topics[spec["name"]] = Topic(meta["flight"], spec["name"], spec["file"], t, frame,
+                                     arrays[f"{i}/lines"], _numbers(arrays, i, columns))
     return assemble_flight(meta["path"], meta["t0_ns"], topics, meta["repairs"])
 
 
-def _frame(z, i: int, columns: list, rows: int) -> pd.DataFrame:
+def _numbers(arrays: dict, i: int, columns: list) -> dict[str, np.ndarray]:
+    """What :meth:`~.flight.Topic.values` gives of the numeric columns, where every
+    value is finite (a column with a bad cell goes through the frame, which names it)."""
+    out = {}
+    for kind in ("float64", "int64"):
+        names = [name for name, dtype in columns if dtype == kind]
+        if not names:
+            continue
+        block = arrays[f"{i}/{kind}"].astype(np.float64)
+        finite = np.isfinite(block).all(axis=0)
+        for j, name in enumerate(names):
+            if finite[j]:
+                v = np.ascontiguousarray(block[:, j])
+                v.setflags(write=False)
+                out[name] = v
+    return out
+
+
+def _frame(arrays: dict, i: int, columns: list, rows: int) -> pd.DataFrame:
     parts = []
     for kind in _BLOCKS:
         names = [name for name, dtype in columns if dtype == kind]
         if names:
-            parts.append(pd.DataFrame(z[f"{i}/{kind}"], columns=names, copy=False))
+            parts.append(pd.DataFrame(arrays[f"{i}/{kind}"], columns=names, copy=False))
     for j, (name, dtype) in enumerate(columns):
         if dtype not in _BLOCKS:
-            values = z[f"{i}/{j}"].astype(object)
-            values[z[f"{i}/{j}/na"]] = np.nan
+            values = arrays[f"{i}/{j}"].astype(object)
+            values[arrays[f"{i}/{j}/na"]] = np.nan
             parts.append(pd.DataFrame({name: pd.Series(values, dtype=dtype)}))
     if not parts:
         return pd.DataFrame(index=pd.RangeIndex(rows))

@@ -35,6 +35,7 @@ from __future__ import annotations
 import io
 import logging
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -116,18 +117,28 @@ class Topic:
     t : ndarray of float64
         Record times in seconds on the flight clock, strictly increasing.
     frame : DataFrame
-        The ``field.*`` columns as read; use :meth:`values` for numbers.
+        The ``field.*`` columns as read; use :meth:`values` for numbers. Given as a
+        function, it is called when first needed: the parsed-flight cache passes one,
+        since building the frames took most of its reading time, and most jobs read
+        only numbers, which it hands to :meth:`values` directly.
     lines : ndarray of int
         1-based line of each row in the file, for messages.
+
+    :meth:`values` keeps what it parsed; :func:`dataclasses.replace` passes that cache
+    on, so a copy must keep the frame (or be given a new cache).
     """
 
     flight: str
     name: str
     file: str
     t: np.ndarray
-    frame: pd.DataFrame
+    _frame: pd.DataFrame | Callable[[], pd.DataFrame]
     lines: np.ndarray
     _cache: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def frame(self) -> pd.DataFrame:
+        return self._frame() if callable(self._frame) else self._frame
 
     def values(self, column: str) -> np.ndarray:
         """Return ``column`` as float64, checked to be finite in every row."""

@@ -41,6 +41,7 @@ import logging
 import os
 import shutil
 import zlib
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -179,7 +180,12 @@ def inject_flight(source: Flight, processed: str | Path, sensor: str, kind: str,
     lines[GROUND_TRUTH] = np.arange(2, len(times) - first + 2)
     t0 = min(int(v[0]) for v in t_ns.values())
     new = {t: Topic(name, t, f"{name}-{t}.csv", (t_ns[t] - t0) * 1e-9, frames[t], lines[t])
-           for t in sorted(t_ns)}
+           for t in sorted(t_ns) if t not in source.topics or t == sig.topic}
+    # the other topics keep the source's frame, and so may share its parsed values:
+    # replace() passes the source topic's cache on, which the grid's other flights fill
+    new |= {t: replace(source.topics[t], flight=name, file=f"{name}-{t}.csv",
+                       t=(t_ns[t] - t0) * 1e-9) for t in t_ns if t not in new}
+    new = dict(sorted(new.items()))
     files = {source.topics[t].file: f"{name}-{t}.csv" for t in keep}
     repairs = [files[r.split(":", 1)[0]] + ":" + r.split(":", 1)[1]
                for r in source.repairs if r.split(":", 1)[0] in files]

@@ -25,6 +25,23 @@ def assert_same_flight(a, b):
         assert x.t.dtype == y.t.dtype and np.array_equal(x.t, y.t), name
         assert np.array_equal(x.lines, y.lines), name
         pd.testing.assert_frame_equal(x.frame, y.frame, check_exact=True)
+        for column in y.frame.columns:
+            assert_same_values(x, y, column)
+
+
+def assert_same_values(x, y, column):
+    """values() gives the same numbers, or the same error, for the cached topic ``x``
+    (which hands out numbers without building its frame) and the parsed one ``y``."""
+    try:
+        expected = y.values(column)
+    except AlfaDataError as e:
+        with pytest.raises(AlfaDataError) as got:
+            x.values(column)
+        assert str(got.value) == str(e)
+        return
+    v = x.values(column)
+    assert v.dtype == np.float64 and not v.flags.writeable
+    assert np.array_equal(v, expected), (x.name, column)
 
 
 def test_a_cached_flight_is_the_parsed_flight(corpus, tmp_path):
@@ -47,9 +64,13 @@ def test_repairs_and_text_columns_survive_the_cache(corpus, tmp_path):
     roll.write_text("\n".join(lines))                          # no final newline
     times = [line.split(",")[0] for line in lines[1:6]]
     modes = ["AUTO", "", "AUTO", "MANUAL", "AUTO"]                # a missing text cell
-    (folder / f"{SOURCE}-mavros-state.csv").write_text("%time,field.mode,field.armed\n" + "".join(
-        f"{t},{m},True\n" for t, m in zip(times, modes, strict=True)))
+    counts = ["1", "2", "", "4", "5"]                             # a missing number
+    (folder / f"{SOURCE}-mavros-state.csv").write_text(
+        "%time,field.mode,field.armed,field.count\n" + "".join(
+            f"{t},{m},True,{c}\n" for t, m, c in zip(times, modes, counts, strict=True)))
     flight = load_flight(folder)
+    with pytest.raises(AlfaDataError, match="empty or NaN cell"):
+        flight.topic("mavros-state").values("field.count")
     assert len(flight.repairs) == 2
     state = flight.topic("mavros-state").frame
     assert state["field.mode"].isna().sum() == 1 and state["field.armed"].dtype == bool
