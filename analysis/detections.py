@@ -53,16 +53,14 @@ log = logging.getLogger(__name__)
 
 def detect_all(method: str, spec: dict, flights: dict[str, Flight], manifest: pd.DataFrame,
                calibration: dict, failures: list[dict] | None = None,
-               calibrate_on: pd.DataFrame | None = None, probes: bool = True
-               ) -> Iterator[tuple[dict, Trace]]:
+               calibrate_on: pd.DataFrame | None = None) -> Iterator[tuple[dict, Trace]]:
     """Records and traces (with probes) of ``spec`` (``{"detector": name, "params":
     {...}}``) on every flight of ``manifest`` with ground truth; ``calibration`` is
     ``{"group_by", "margin_s"}``.
 
     A calibrated method is fitted per fold on the other groups' flights of
     ``calibrate_on`` (default ``manifest``): injected flights are scored by the
-    model of their source's group, fitted on real flights only. ``probes`` keeps the
-    intermediates in the traces.
+    model of their source's group, fitted on real flights only.
 
     With ``failures`` None, a flight that cannot be read raises its
     :class:`~alfa_bench.data.AlfaDataError`; with a list, the flight is skipped and a
@@ -89,7 +87,7 @@ def detect_all(method: str, spec: dict, flights: dict[str, Flight], manifest: pd
 
     def run(name: str, info: dict | None = None):
         return guarded("detect", name, lambda: detection_record(
-            method, spec, detector, flights[name], sha, info, probes))
+            method, spec, detector, flights[name], sha, info))
 
     def uncalibrated(names: list[str], error: ValueError) -> None:
         if failures is None:
@@ -151,14 +149,14 @@ def calibration_failure(flight: str, method: str, error: ValueError, calibration
 
 
 def detection_record(method: str, spec: dict, detector: Detector, flight: Flight,
-                     sha256: dict[str, str], calibration: dict | None = None,
-                     probes: bool = True) -> tuple[dict, Trace]:
+                     sha256: dict[str, str], calibration: dict | None = None
+                     ) -> tuple[dict, Trace]:
     """Run ``detector`` (fitted if calibrated) on ``flight``: its record and trace.
     ``sha256`` maps flights to their checksums; the record's provenance gives those of
     ``flight`` and of the flights that calibrated the detector."""
     if flight.fault is None:
         raise ValueError(f"flight {flight.id} has no ground truth and cannot be scored")
-    trace = run_detector(detector, flight, probes=probes)
+    trace = run_detector(detector, flight)
     onset = flight.fault.onset_s
     first = trace.first_alarm_s()
     outputs = dict(zip(trace.channels, detector.channel_outputs(), strict=True))
@@ -218,23 +216,38 @@ def read_failures(folders) -> list[pd.DataFrame]:
 
 
 def write_detections(method: str, spec: dict, flights: dict[str, Flight], manifest: pd.DataFrame,
-                     calibration: dict, *, strict: bool, config: dict, out: Path,
-                     traces: Path | None, calibrate_on: pd.DataFrame | None = None,
-                     probes: bool = True) -> None:
+                     calibration: dict, *, strict: bool, config: dict, out: Path, traces: Path,
+                     injected: tuple[pd.DataFrame, Path] | None = None) -> None:
     """Run :func:`detect_all` and write ``out/<flight>.json``, ``traces/<flight>.npz``
-    (unless ``traces`` is None) and ``out/failures.csv`` (the flights excluded, empty
-    when ``strict``, which raises instead), each with its provenance."""
-    for folder in (out, traces):
-        if folder is not None:
-            folder.mkdir(parents=True, exist_ok=True)
+    and ``out/failures.csv`` (the flights excluded, empty when ``strict``, which
+    raises instead), each with its provenance.
+
+    With ``injected`` (its manifest, and a folder), the injected flights of that
+    manifest (in ``flights``) are scored in the same pass, each by the fit of its
+    source's fold (one fit per fold for both), and their records and failures are
+    written to the folder, without traces: a record holds all that is read of them.
+    """
+    extra, folder = injected if injected is not None else (manifest.iloc[:0], None)
+    for path in (out, traces, folder):
+        if path is not None:
+            path.mkdir(parents=True, exist_ok=True)
     failures = None if strict else []
-    for record, trace in detect_all(method, spec, flights, manifest, calibration, failures,
-                                    calibrate_on, probes):
-        write_record(record, out / f"{record['flight']}.json")
-        if traces is not None:
-            write_trace(trace, traces / f"{record['flight']}.npz", record["provenance"])
-        log.info("%s %s: %s, first alarm %s", method, record["flight"], record["outcome"],
+    scored = pd.concat([manifest, extra], ignore_index=True) if len(extra) else manifest
+    grid = set(extra["flight"])
+    for record, trace in detect_all(method, spec, flights, scored, calibration, failures,
+                                    calibrate_on=manifest):
+        name = record["flight"]
+        write_record(record, (folder if name in grid else out) / f"{name}.json")
+        if name not in grid:
+            write_trace(trace, traces / f"{name}.npz", record["provenance"])
+        log.info("%s %s: %s, first alarm %s", method, name, record["outcome"],
                  record["first_alarm_s"])
-    pd.DataFrame(failures or [], columns=FAILURE_COLUMNS).to_csv(out / "failures.csv",
-                                                                  index=False)
-    stamp(out / "failures.csv", run_provenance(config, manifest, calibrate_on))
+    for where, rows, prov in [
+            (out, [f for f in failures or [] if f["flight"] not in grid],
+             run_provenance(config, manifest)),
+            (folder, [f for f in failures or [] if f["flight"] in grid],
+             run_provenance(config, extra, manifest))]:
+        if where is not None:
+            pd.DataFrame(rows, columns=FAILURE_COLUMNS).to_csv(where / "failures.csv",
+                                                               index=False)
+            stamp(where / "failures.csv", prov)

@@ -11,6 +11,9 @@ METHODS = list(config["methods"])
 # speak of ALFA's metric and emulation, not of sensors
 DETECTORS = [m for m, spec in config["methods"].items()
              if spec.get("role", "method") != "reference"]
+REFERENCES = [m for m in METHODS if m not in DETECTORS]
+# where `snakemake injected_csv` writes the injected flights, and so their folder name
+INJECTED_PROCESSED = "results/injected/processed"
 
 # the schema checks the config's shape; each method's detector and parameter names are
 # checked against the registry here, before any job runs

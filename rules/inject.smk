@@ -1,9 +1,5 @@
 # The injected sensor-fault grid (data/inject.py): built from the fault-free flights,
-# scored by every method, calibrated on the real flights only.
-
-
-# where `snakemake injected_csv` writes the injected flights, and so their folder name
-INJECTED_PROCESSED = "results/injected/processed"
+# scored by the detect jobs (rules/detect.smk), calibrated on the real flights only.
 
 
 rule inject:
@@ -21,31 +17,6 @@ rule inject:
         "results/logs/inject.log",
     script:
         "../scripts/inject.py"
-
-
-# One job per method: each builds the injected flights in memory from the cached
-# fault-free flights (data/inject.py), so a changed method re-runs only its own job.
-rule detect_injected:
-    input:
-        manifest="results/injected/flights.csv",
-        calibrate_on="data/flights.csv",
-        cache="results/cache",
-        code=lambda w: detector_code(w.method),
-    output:
-        detections=directory("results/injected/detections/{method}"),
-    params:
-        # canonical JSON: a changed value re-runs this job, a reordered key does not
-        spec=lambda w: json.dumps(config["methods"][w.method], sort_keys=True),
-        injection=config["injection"],
-        processed=INJECTED_PROCESSED,
-        calibration=config["calibration"],
-        strict=config["strict"],
-    log:
-        "results/logs/detect_injected/{method}.log",
-    benchmark:
-        "results/benchmarks/detect_injected/{method}.tsv"
-    script:
-        "../scripts/detect_injected.py"
 
 
 # ALFA-format CSV copies of the injected flights, for use outside the pipeline; never

@@ -43,6 +43,7 @@ rule runtime:
     input:
         manifest="data/flights.csv",
         detections=expand("results/detections/{method}", method=METHODS),
+        injected=expand("results/injected/detections/{method}", method=DETECTORS),
         benchmarks=expand("results/benchmarks/detect/{method}.tsv", method=METHODS),
     output:
         csv="results/runtime/runtime.csv",

@@ -1,17 +1,34 @@
-"""Snakemake script: run one configured method over every flight with ground truth;
-write its detection records, traces, and the flights it had to exclude."""
+"""Snakemake script: run one configured method over every flight with ground truth and,
+for a method scored on it, over the injected sensor-fault grid, built in memory from
+the cached fault-free flights; each fold is fitted once, on real flights only. Writes
+the detection records, traces, and the flights the method had to exclude."""
 
 import json
 from pathlib import Path
 
 from alfa_bench.analysis.detections import write_detections
 from alfa_bench.analysis.logs import log_to
-from alfa_bench.data import load_cached, read_manifest
+from alfa_bench.data import AlfaDataError, load_cached, read_manifest
+from alfa_bench.data.inject import injected_flights
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 manifest = read_manifest(sm.input.manifest)
 flights = load_cached(sm.input.cache, manifest)
+injected = None
+if "injected" in sm.output.keys():
+    grid, on_grid = sm.params.injection, read_manifest(sm.input.injected)
+    free = manifest.loc[manifest["fault_class"] == "none", "flight"]
+    built, _ = injected_flights({name: flights[name] for name in free}, manifest,
+                                sm.params.processed, grid["sensors"], grid["faults"],
+                                grid["onsets"])
+    if {name: sha for name, (_, sha) in built.items()} != dict(
+            zip(on_grid["flight"], on_grid["sha256"], strict=True)):
+        raise AlfaDataError(f"{sm.input.injected} is not the grid the config and the "
+                            "cached flights give: re-run the inject rule")
+    flights |= {name: flight for name, (flight, _) in built.items()}
+    injected = on_grid, Path(sm.output.injected)
 write_detections(sm.wildcards.method, json.loads(sm.params.spec), flights, manifest,
                  dict(sm.params.calibration), strict=sm.params.strict, config=sm.config,
-                 out=Path(sm.output.detections), traces=Path(sm.output.traces))
+                 out=Path(sm.output.detections), traces=Path(sm.output.traces),
+                 injected=injected)
