@@ -191,7 +191,8 @@ class FlightFigure:
         self.title.set_text(f"{flight}\nscore / threshold (dashed: alarm level; grey: "
                             "fault; red line: first alarm)")
         Path(path).parent.mkdir(parents=True, exist_ok=True)
-        self.fig.savefig(path, dpi=_DPI, metadata=_METADATA)
+        # the fastest deflate: 6 % larger files, a fifth less time a figure
+        self.fig.savefig(path, dpi=_DPI, metadata=_METADATA, pil_kwargs={"compress_level": 1})
 
     def close(self) -> None:
         plt.close(self.fig)
