@@ -17,6 +17,7 @@ it.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
@@ -38,7 +39,7 @@ EMPTY = ("No injected sensor fault was scored: sensor faults are injected into f
          "(results/injected/skipped.csv lists the pairs left out).")
 
 
-def detectability_table(records: list[dict], manifest: pd.DataFrame,
+def detectability_table(records: Iterable[dict], manifest: pd.DataFrame,
                         clean: list[dict]) -> pd.DataFrame:
     """Per method, sensor, kind and magnitude: flights, detected, alarmed before the
     onset, missed, detection rate, chance rate (from ``clean``, the records of the

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import json
 import logging
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from pathlib import Path
 
 import pandas as pd
@@ -45,13 +45,13 @@ from .provenance import provenance, read_table, run_provenance, stamp
 from .scoring import flight_outcome
 from .traces import write_trace
 
-__all__ = ["calibration_failure", "detect_all", "detection_record", "read_failures",
-           "read_records", "write_detections", "write_record"]
+__all__ = ["calibration_failure", "detect_all", "detection_record", "iter_records",
+           "read_failures", "read_records", "write_detections", "write_record"]
 
 log = logging.getLogger(__name__)
 
 
-def detect_all(method: str, spec: dict, flights: dict[str, Flight], manifest: pd.DataFrame,
+def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest: pd.DataFrame,
                calibration: dict, failures: list[dict] | None = None,
                calibrate_on: pd.DataFrame | None = None) -> Iterator[tuple[dict, Trace]]:
     """Records and traces (with probes) of ``spec`` (``{"detector": name, "params":
@@ -206,7 +206,15 @@ def write_record(record: dict, path: Path) -> None:
 
 def read_records(folders) -> list[dict]:
     """All records in the given ``results/detections/{method}`` folders."""
-    return [json.loads(p.read_text()) for d in folders for p in sorted(Path(d).glob("*.json"))]
+    return list(iter_records(folders))
+
+
+def iter_records(folders) -> Iterator[dict]:
+    """The records of :func:`read_records`, one at a time: the injected grid of a
+    large corpus has more than fit in memory at once."""
+    for d in folders:
+        for p in sorted(Path(d).glob("*.json")):
+            yield json.loads(p.read_text())
 
 
 def read_failures(folders) -> list[pd.DataFrame]:
@@ -215,7 +223,8 @@ def read_failures(folders) -> list[pd.DataFrame]:
             for d in folders]
 
 
-def write_detections(method: str, spec: dict, flights: dict[str, Flight], manifest: pd.DataFrame,
+def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
+                     manifest: pd.DataFrame,
                      calibration: dict, *, strict: bool, config: dict, out: Path, traces: Path,
                      injected: tuple[pd.DataFrame, Path] | None = None) -> None:
     """Run :func:`detect_all` and write ``out/<flight>.json``, ``traces/<flight>.npz``

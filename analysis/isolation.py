@@ -16,6 +16,8 @@ detection scores, not here.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import numpy as np
 import pandas as pd
 
@@ -72,7 +74,7 @@ def _ratio_row(trace: Trace, k: int) -> np.ndarray:
         return trace.score[k] / trace.threshold
 
 
-def isolation_rows(records: list[dict], truth: str) -> pd.DataFrame:
+def isolation_rows(records: Iterable[dict], truth: str) -> pd.DataFrame:
     """Per record of a faulty flight: method, flight, the ``true`` sensor (``truth=
     "sensor"``, from ``fault_sensor``) or actuator class (``truth="actuator"``), and
     the ``predicted`` one, from the record's ``isolated_sensor`` (:func:`isolate`)."""

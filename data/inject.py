@@ -25,7 +25,7 @@ The new flight is named ``<source date-time>_<part>_sensor_<sensor>_<kind><100 m
 _at<onset s>_failure``.
 
 The workflow builds these flights in memory (:func:`inject_flight`,
-:func:`injected_flights`) from the parsed source flights, whenever a job needs them: the
+:class:`InjectedGrid`) from the parsed source flights, whenever a job needs them: the
 same :class:`~.flight.Flight` that reading :func:`inject_sensor_fault`'s files gives,
 array for array (the two parsers agree on every cell of ALFA, and ``repr`` round-trips).
 The CSV copies are written only on request (``snakemake injected_csv``). An injected
@@ -41,6 +41,7 @@ import logging
 import os
 import shutil
 import zlib
+from collections.abc import Iterator, Mapping
 from dataclasses import replace
 from pathlib import Path
 
@@ -53,8 +54,8 @@ from .signals import SIGNALS, not_measured
 
 log = logging.getLogger("alfa_bench.data")
 
-__all__ = ["KINDS", "RAMP_S", "SENSORS", "grid_specs", "inject_flight", "inject_grid",
-           "inject_sensor_fault", "injected_flights", "injected_name", "injected_sha256"]
+__all__ = ["KINDS", "RAMP_S", "SENSORS", "InjectedGrid", "grid_specs", "inject_flight",
+           "inject_grid", "inject_sensor_fault", "injected_name", "injected_sha256"]
 
 #: The sensors a fault can be injected into: the measured signals.
 SENSORS = ("roll", "pitch", "yaw", "airspeed", "roll_rate", "pitch_rate", "yaw_rate")
@@ -228,29 +229,48 @@ def grid_specs(sources: dict[str, Flight], manifest, sensors, faults,
     return specs, skipped
 
 
-def injected_flights(sources: dict[str, Flight], manifest, processed: str | Path, sensors,
-                     faults, onsets) -> tuple[dict[str, tuple[Flight, str]], list[dict]]:
-    """The grid of :func:`grid_specs` built in memory (:func:`inject_flight`, only the
-    topics of :data:`~.signals.SIGNALS`): ``{name: (flight, sha256)}`` in grid order,
-    and the skipped pairs."""
-    topics = {s.topic for s in SIGNALS.values()}
-    sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
-    specs, skipped = grid_specs(sources, manifest, sensors, faults, onsets)
-    out = {}
-    for spec in specs:
-        flight = inject_flight(sources[spec["source"]], processed, spec["sensor"],
-                               spec["kind"], spec["magnitude"], spec["onset_s"], topics=topics)
-        out[flight.id] = flight, injected_sha256(sha[spec["source"]], spec["sensor"],
-                                                 spec["kind"], spec["magnitude"],
-                                                 spec["onset_s"])
-    return out, skipped
+class InjectedGrid(Mapping[str, Flight]):
+    """The grid of :func:`grid_specs`, by flight name: each flight is built in memory
+    (:func:`inject_flight`, only the topics of :data:`~.signals.SIGNALS`) when looked
+    up, and not kept, so that a large corpus's grid need not fit in memory.
+
+    Attributes
+    ----------
+    sha256 : dict
+        Each flight's checksum (:func:`injected_sha256`), in grid order.
+    skipped : list of dict
+        The flight-sensor pairs left out (:func:`grid_specs`).
+    """
+
+    def __init__(self, sources: dict[str, Flight], manifest, processed: str | Path,
+                 sensors, faults, onsets):
+        self.sources, self.processed = sources, processed
+        specs, self.skipped = grid_specs(sources, manifest, sensors, faults, onsets)
+        self.specs = {injected_name(s["source"], s["sensor"], s["kind"], s["magnitude"],
+                                    s["onset_s"]): s for s in specs}
+        sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
+        self.sha256 = {name: injected_sha256(sha[s["source"]], s["sensor"], s["kind"],
+                                             s["magnitude"], s["onset_s"])
+                       for name, s in self.specs.items()}
+
+    def __getitem__(self, name: str) -> Flight:
+        spec = self.specs[name]
+        return inject_flight(self.sources[spec["source"]], self.processed, spec["sensor"],
+                             spec["kind"], spec["magnitude"], spec["onset_s"],
+                             topics={s.topic for s in SIGNALS.values()})
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.specs)
+
+    def __len__(self) -> int:
+        return len(self.specs)
 
 
 def inject_grid(processed: Path, manifest, out: Path, sensors, faults,
                 onsets) -> tuple[list[Path], list[dict]]:
     """The grid of :func:`grid_specs` over the flights under ``processed``, written as
     ALFA-format folders under ``out`` (only the topics of :data:`~.signals.SIGNALS`):
-    the CSV copies of :func:`injected_flights`. Returns the new folders, and the
+    the CSV copies of :class:`InjectedGrid`. Returns the new folders, and the
     skipped pairs."""
     topics = {s.topic for s in SIGNALS.values()}
     sources = {name: load_flight(Path(processed) / name)

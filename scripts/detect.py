@@ -4,12 +4,13 @@ the cached fault-free flights; each fold is fitted once, on real flights only. W
 the detection records, traces, and the flights the method had to exclude."""
 
 import json
+from collections import ChainMap
 from pathlib import Path
 
 from alfa_bench.analysis.detections import write_detections
 from alfa_bench.analysis.logs import log_to
 from alfa_bench.data import AlfaDataError, load_cached, read_manifest
-from alfa_bench.data.inject import injected_flights
+from alfa_bench.data.inject import InjectedGrid
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
@@ -19,14 +20,12 @@ injected = None
 if "injected" in sm.output.keys():
     grid, on_grid = sm.params.injection, read_manifest(sm.input.injected)
     free = manifest.loc[manifest["fault_class"] == "none", "flight"]
-    built, _ = injected_flights({name: flights[name] for name in free}, manifest,
-                                sm.params.processed, grid["sensors"], grid["faults"],
-                                grid["onsets"])
-    if {name: sha for name, (_, sha) in built.items()} != dict(
-            zip(on_grid["flight"], on_grid["sha256"], strict=True)):
+    built = InjectedGrid({name: flights[name] for name in free}, manifest,
+                         sm.params.processed, grid["sensors"], grid["faults"], grid["onsets"])
+    if built.sha256 != dict(zip(on_grid["flight"], on_grid["sha256"], strict=True)):
         raise AlfaDataError(f"{sm.input.injected} is not the grid the config and the "
                             "cached flights give: re-run the inject rule")
-    flights |= {name: flight for name, (flight, _) in built.items()}
+    flights = ChainMap(flights, built)       # each injected flight built when scored
     injected = on_grid, Path(sm.output.injected)
 write_detections(sm.wildcards.method, json.loads(sm.params.spec), flights, manifest,
                  dict(sm.params.calibration), strict=sm.params.strict, config=sm.config,

@@ -8,6 +8,7 @@ from alfa_bench.analysis.detectability import (
     detectability_markdown,
     detectability_table,
 )
+from alfa_bench.analysis.detections import iter_records
 from alfa_bench.analysis.logs import log_to
 from alfa_bench.analysis.provenance import run_provenance, stamp
 from alfa_bench.data import read_manifest
@@ -16,7 +17,7 @@ sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 manifest = read_manifest(sm.input.manifest)
 real = read_manifest(sm.input.calibrate_on)
-table = detectability_table(read_records(sm.input.detections), manifest,
+table = detectability_table(iter_records(sm.input.detections), manifest,
                             read_records(sm.input.clean))
 table.to_csv(sm.output.csv, index=False)
 Path(sm.output.md).write_text(detectability_markdown(table))

@@ -8,7 +8,7 @@ import pandas as pd
 from alfa_bench.analysis.logs import log_to
 from alfa_bench.analysis.provenance import run_provenance, stamp
 from alfa_bench.data import load_cached, read_manifest
-from alfa_bench.data.inject import injected_flights
+from alfa_bench.data.inject import InjectedGrid
 from alfa_bench.data.manifest import manifest_of, manifest_row
 
 sm = snakemake  # noqa: F821
@@ -17,13 +17,13 @@ grid = sm.params.injection
 manifest = read_manifest(sm.input.manifest)
 sources = load_cached(sm.input.cache, manifest,
                       manifest.loc[manifest["fault_class"] == "none", "flight"])
-flights, skipped = injected_flights(sources, manifest, sm.params.processed,
-                                    grid["sensors"], grid["faults"], grid["onsets"])
+flights = InjectedGrid(sources, manifest, sm.params.processed, grid["sensors"],
+                       grid["faults"], grid["onsets"])
 logging.info("%d injected flights; %d flight-sensor pairs skipped", len(flights),
-             len(skipped))
-pd.DataFrame(skipped, columns=["flight", "sensor", "reason"]).to_csv(sm.output.skipped,
-                                                                     index=False)
+             len(flights.skipped))
+pd.DataFrame(flights.skipped, columns=["flight", "sensor", "reason"]).to_csv(
+    sm.output.skipped, index=False)
 stamp(sm.output.skipped, run_provenance(sm.config, manifest))
 # a corpus without fault-free flights gives an empty grid: an empty manifest
-manifest_of([manifest_row(f, sha) for f, sha in flights.values()]).to_csv(
-    sm.output.manifest, index=False)
+manifest_of([manifest_row(flights[name], sha) for name, sha in flights.sha256.items()]
+            ).to_csv(sm.output.manifest, index=False)

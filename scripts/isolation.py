@@ -3,7 +3,7 @@ sensor) and of ALFA's actuator faults (which actuator class)."""
 
 from pathlib import Path
 
-from alfa_bench.analysis import read_records
+from alfa_bench.analysis.detections import iter_records
 from alfa_bench.analysis.isolation import isolation_markdown, isolation_rows
 from alfa_bench.analysis.logs import log_to
 from alfa_bench.analysis.provenance import run_provenance, stamp
@@ -15,7 +15,7 @@ real, injected = read_manifest(sm.input.manifest), read_manifest(sm.input.inject
 for records, truth, csv, md in [
         (sm.input.injected_detections, "sensor", sm.output.sensors_csv, sm.output.sensors_md),
         (sm.input.detections, "actuator", sm.output.actuators_csv, sm.output.actuators_md)]:
-    rows = isolation_rows(read_records(records), truth)
+    rows = isolation_rows(iter_records(records), truth)
     rows.to_csv(csv, index=False)
     Path(md).write_text(isolation_markdown(rows, truth))
     prov = (run_provenance(sm.config, injected, real) if truth == "sensor"

@@ -5,9 +5,16 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from alfa_bench.data import SIGNALS, AlfaDataError, load_flight, read_cached
+from alfa_bench.data import SIGNALS, AlfaDataError, build_manifest, load_flight, read_cached
 from alfa_bench.data.cache import write_cached
-from alfa_bench.data.inject import KINDS, inject_flight, inject_sensor_fault
+from alfa_bench.data.inject import (
+    KINDS,
+    InjectedGrid,
+    grid_specs,
+    inject_flight,
+    inject_sensor_fault,
+    injected_sha256,
+)
 from alfa_bench.data.manifest import flight_sha256
 from alfa_bench.methods import make_detector, run_detector
 
@@ -99,3 +106,26 @@ def test_an_injected_flight_in_memory_is_its_csv_copy_read_back(corpus, tmp_path
         {"name": "roll", "input": "roll_cmd", "output": "roll"}]})
     a, b = run_detector(detector, built), run_detector(detector, written)
     assert np.array_equal(a.score, b.score, equal_nan=True)
+
+
+def test_the_grid_builds_each_flight_when_looked_up_and_keeps_none(corpus, tmp_path):
+    """Names and checksums come from the specs alone; a lookup builds the flight that
+    inject_flight builds, afresh each time (a large grid is never held in memory)."""
+    manifest = build_manifest(corpus)
+    free = manifest.loc[manifest["fault_class"] == "none", "flight"]
+    sources = {name: load_flight(corpus / name) for name in free}
+    faults = [{"kind": "drift", "magnitude": 0.5}, {"kind": "stuck", "magnitude": 0.0}]
+    grid = InjectedGrid(sources, manifest, tmp_path, ["roll", "pitch"], faults, [0.4])
+    specs, skipped = grid_specs(sources, manifest, ["roll", "pitch"], faults, [0.4])
+    assert len(grid) == len(specs) == 4 * len(free) and grid.skipped == skipped
+    sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
+    assert sorted(grid.sha256.values()) == sorted(
+        injected_sha256(sha[s["source"]], s["sensor"], s["kind"], s["magnitude"],
+                        s["onset_s"]) for s in specs)
+    name, spec = next(iter(grid.specs.items()))
+    topics = {s.topic for s in SIGNALS.values()}
+    assert_same_flight(grid[name], inject_flight(
+        sources[spec["source"]], tmp_path, spec["sensor"], spec["kind"], spec["magnitude"],
+        spec["onset_s"], topics=topics))
+    assert grid[name] is not grid[name]
+    assert list(grid) == list(grid.sha256)
