@@ -224,8 +224,8 @@ def read_failures(folders) -> list[pd.DataFrame]:
 
 
 def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
-                     manifest: pd.DataFrame,
-                     calibration: dict, *, strict: bool, config: dict, out: Path, traces: Path,
+                     manifest: pd.DataFrame, calibration: dict, *, strict: bool, config: dict,
+                     out: Path, traces: Path,
                      injected: tuple[pd.DataFrame, Path] | None = None) -> None:
     """Run :func:`detect_all` and write ``out/<flight>.json``, ``traces/<flight>.npz``
     and ``out/failures.csv`` (the flights excluded, empty when ``strict``, which
