@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-__all__ = ["GROUPINGS", "folds"]
+__all__ = ["GROUPINGS", "folds", "groups_of"]
 
 #: manifest column that defines a group
 GROUPINGS = {"date": "date", "flight": "flight"}
@@ -31,3 +31,21 @@ def folds(manifest: pd.DataFrame, group_by: str) -> dict[str, tuple[list[str], l
     # job that calibrates would pay its import, ~0.7 s, for these three lines)
     return {g: (flights[groups == g].tolist(), flights[groups != g].tolist())
             for g in dict.fromkeys(groups)}
+
+
+def groups_of(scored: pd.DataFrame, train: pd.DataFrame, group_by: str) -> pd.Series:
+    """The group of each flight of ``scored``, whose fold scores it: its own, but an
+    injected flight's (``fault_source`` set) is its source's group in ``train``, so
+    that it is scored by the fold that left its source out, whatever the grouping."""
+    own = scored[GROUPINGS[group_by]].astype(str)
+    if "fault_source" not in scored:
+        return own
+    source = scored["fault_source"].fillna("").astype(str)
+    of_source = dict(zip(train["flight"], train[GROUPINGS[group_by]].astype(str),
+                         strict=True))
+    injected = source != ""
+    unknown = sorted(set(source[injected]) - set(of_source))
+    if unknown:
+        raise ValueError(f"injected flights' sources are not among the calibration "
+                         f"flights: {unknown}")
+    return own.where(~injected, source.map(of_source))

@@ -39,7 +39,7 @@ from alfa_bench.methods import (
     run_detector,
 )
 
-from .calibration import GROUPINGS, folds
+from .calibration import folds, groups_of
 from .isolation import isolate
 from .provenance import provenance, read_table, run_provenance, stamp
 from .scoring import flight_outcome
@@ -101,8 +101,8 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
             if (out := run(name)) is not None:
                 yield out
         return
-    groups = manifest.loc[manifest["ground_truth"]]
-    groups = groups.groupby(groups[GROUPINGS[calibration["group_by"]]].astype(str))["flight"]
+    scored = manifest.loc[manifest["ground_truth"]]
+    groups = scored.groupby(groups_of(scored, train, calibration["group_by"]))["flight"]
     scored_by_fold = {g: list(f) for g, f in groups}
     try:
         by_fold = folds(train, calibration["group_by"])

@@ -1,12 +1,16 @@
 """Calibration without leakage: folds, fault-free segments, and what records say."""
 
 import dataclasses
+from collections import ChainMap
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from alfa_bench.analysis import detect_all, folds
 from alfa_bench.data import build_manifest, load_flight
+from alfa_bench.data.inject import InjectedGrid
+from alfa_bench.data.manifest import manifest_of, manifest_row
 from alfa_bench.methods import fault_free_segments, make_detector
 
 CALIBRATION = {"group_by": "date", "margin_s": 1.0}
@@ -96,3 +100,27 @@ def test_a_single_date_is_a_failure_row_for_every_flight(flights, manifest):
     assert list(detect_all("glrt", spec, flights, one_day, CALIBRATION, failures)) == []
     assert sorted(f["flight"] for f in failures) == sorted(one_day["flight"])
     assert all("at least two date groups" in f["error"] for f in failures)
+
+
+@pytest.mark.parametrize("group_by", ["date", "flight"])
+def test_an_injected_flight_is_scored_by_the_fold_that_left_its_source_out(
+        flights, manifest, tmp_path, group_by):
+    """Under either grouping (leaving out one flight used to leave every injected
+    flight without a fold, so none was scored)."""
+    free = manifest.loc[manifest["fault_class"] == "none", "flight"]
+    grid = InjectedGrid({f: flights[f] for f in free}, manifest, tmp_path, ["roll"],
+                        [{"kind": "drift", "magnitude": 0.5}], [0.4])
+    injected = manifest_of([manifest_row(grid[n], sha) for n, sha in grid.sha256.items()])
+    scored = pd.concat([manifest, injected], ignore_index=True)
+    spec = {"detector": "glrt_residuals", "params": {}}
+    records = {r["flight"]: r for r, _ in detect_all(
+        "glrt", spec, ChainMap(flights, grid), scored,
+        {**CALIBRATION, "group_by": group_by}, calibrate_on=manifest)}
+    source = dict(zip(injected["flight"], injected["fault_source"], strict=True))
+    assert set(source) <= set(records)
+    column = {"date": "date", "flight": "flight"}[group_by]
+    own = dict(zip(manifest["flight"], manifest[column], strict=True))
+    for name, src in source.items():
+        cal = records[name]["calibration"]
+        assert cal["fold"] == own[src] and src not in cal["flights"]
+        assert cal["fitted"] == records[src]["calibration"]["fitted"]
