@@ -156,7 +156,7 @@ def detection_record(method: str, spec: dict, detector: Detector, flight: Flight
     ``flight`` and of the flights that calibrated the detector."""
     if flight.fault is None:
         raise ValueError(f"flight {flight.id} has no ground truth and cannot be scored")
-    trace = run_detector(detector, flight)
+    trace = run_detector(detector, flight, probes=True)
     onset = flight.fault.onset_s
     first = trace.first_alarm_s()
     outputs = dict(zip(trace.channels, detector.channel_outputs(), strict=True))

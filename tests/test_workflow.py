@@ -17,6 +17,7 @@ from loopback import make_archive, serve_archive
 from recordings import content
 
 from alfa_bench.analysis.provenance import read_provenance, read_table
+from alfa_bench.analysis.traces import read_trace
 from alfa_bench.methods import REGISTRY, make_detector
 from synthetic import write_flight
 
@@ -95,6 +96,8 @@ def test_outputs_and_their_contents(runs, corpus):
                 "reads_actuators", "signal_kinds", "skipped_channels",
                 "isolated_sensor"} <= set(r)
         assert r["provenance"]["inputs"]["flight_sha256"]
+    # the traces keep the intermediates the rerun recordings show
+    assert read_trace(next((out / "traces/rls_arx_zscore").glob("*.npz"))).probes
     assert "Keipour et al. ICRA 2019 (paper)" in (out / "tables/summary.md").read_text()
     comparison = read_table(out / "tables/comparison.csv")
     assert set(comparison["method"]) == set(config["methods"])
