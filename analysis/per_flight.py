@@ -20,6 +20,7 @@ any threshold.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
@@ -74,7 +75,7 @@ def margins(trace: Trace, onset_s: float | None,
     return in_time[0], in_time[1], peak(before)[0]
 
 
-def per_flight_table(records: list[dict], traces: dict[tuple[str, str], Trace],
+def per_flight_table(records: list[dict], traces: Mapping[tuple[str, str], Trace],
                      manifest: pd.DataFrame, deadline_s: float,
                      subset: str = "all") -> pd.DataFrame:
     """One row per record of a flight of ``subset``: method, block, flight, fault class,

@@ -19,6 +19,8 @@ fault-free flight: whole fault-free flights and faulty flights before onset.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 import pandas as pd
 
@@ -60,7 +62,7 @@ def flight_curves(trace: Trace, onset_s: float | None, scales: np.ndarray) -> di
     return {"first_alarm_s": first_s, "events": events, "free_s": n_free * dt}
 
 
-def sweep_table(records: list[dict], traces: dict[tuple[str, str], Trace],
+def sweep_table(records: list[dict], traces: Mapping[tuple[str, str], Trace],
                 manifest: pd.DataFrame, subsets, deadline_s: float,
                 scales=DEFAULT_SCALES) -> pd.DataFrame:
     """Per method, subset and scale: the scoring of :func:`~.scoring.summarize` under

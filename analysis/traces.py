@@ -11,6 +11,7 @@ the same bytes.
 from __future__ import annotations
 
 import json
+from collections.abc import Iterator, Mapping
 from pathlib import Path
 
 import numpy as np
@@ -50,7 +51,26 @@ def read_trace(path: str | Path) -> Trace:
                      probes={str(n): probes[:, i] for i, n in enumerate(z["probe_names"])})
 
 
-def read_traces(folders) -> dict[tuple[str, str], Trace]:
-    """Every trace in the given ``results/traces/{method}`` folders, by (method, flight)."""
-    return {(Path(d).name, p.stem): read_trace(p)
-            for d in folders for p in sorted(Path(d).glob("*.npz"))}
+def read_traces(folders) -> Mapping[tuple[str, str], Trace]:
+    """Every trace in the given ``results/traces/{method}`` folders, by (method, flight),
+    each read from its file when looked up and not kept: the traces of a large corpus
+    do not fit in memory together (at 16 times ALFA's flights they took 4 GB)."""
+    return _Traces({(Path(d).name, p.stem): p
+                    for d in folders for p in sorted(Path(d).glob("*.npz"))})
+
+
+class _Traces(Mapping[tuple[str, str], Trace]):
+    def __init__(self, paths: dict[tuple[str, str], Path]):
+        self.paths = paths
+
+    def __getitem__(self, key: tuple[str, str]) -> Trace:
+        return read_trace(self.paths[key])
+
+    def __contains__(self, key) -> bool:         # Mapping's would read the file
+        return key in self.paths
+
+    def __iter__(self) -> Iterator[tuple[str, str]]:
+        return iter(self.paths)
+
+    def __len__(self) -> int:
+        return len(self.paths)

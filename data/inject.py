@@ -259,6 +259,9 @@ class InjectedGrid(Mapping[str, Flight]):
                              spec["kind"], spec["magnitude"], spec["onset_s"],
                              topics={s.topic for s in SIGNALS.values()})
 
+    def __contains__(self, name) -> bool:        # Mapping's would build the flight
+        return name in self.specs
+
     def __iter__(self) -> Iterator[str]:
         return iter(self.specs)
 

@@ -128,4 +128,6 @@ def test_the_grid_builds_each_flight_when_looked_up_and_keeps_none(corpus, tmp_p
         sources[spec["source"]], tmp_path, spec["sensor"], spec["kind"], spec["magnitude"],
         spec["onset_s"], topics=topics))
     assert grid[name] is not grid[name]
+    grid.sources = {}                                   # a lookup now fails, a test not
+    assert name in grid and "no such flight" not in grid
     assert list(grid) == list(grid.sha256)

@@ -32,3 +32,15 @@ def test_the_same_trace_gives_the_same_bytes(one_flight, tmp_path):
     write_trace(trace, tmp_path / "b.npz", {})
     assert (tmp_path / "a.npz").read_bytes() == (tmp_path / "b.npz").read_bytes()
     assert read_trace(tmp_path / "a.npz").probes == {}
+
+
+def test_traces_are_read_when_looked_up(one_flight, tmp_path):
+    """read_traces lists the traces without reading them, and reads one per lookup."""
+    trace = run_detector(make_detector("rls_arx_zscore"), load_flight(one_flight))
+    for name in ("f", "g"):
+        write_trace(trace, tmp_path / "rls" / f"{name}.npz", {})
+    traces = read_traces([tmp_path / "rls"])
+    (tmp_path / "rls" / "g.npz").write_bytes(b"not a trace")
+    assert len(traces) == 2 and ("rls", "g") in traces
+    np.testing.assert_array_equal(traces["rls", "f"].score, trace.score)
+    assert traces["rls", "f"] is not traces["rls", "f"]
