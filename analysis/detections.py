@@ -210,8 +210,8 @@ def read_records(folders) -> list[dict]:
 
 
 def iter_records(folders) -> Iterator[dict]:
-    """The records of :func:`read_records`, one at a time: the injected grid of a
-    large corpus has more than fit in memory at once."""
+    """The records of :func:`read_records`, one at a time, so that memory does not
+    grow with the injected grid (145,000 records at 16 times ALFA's flights)."""
     for d in folders:
         for p in sorted(Path(d).glob("*.json")):
             yield json.loads(p.read_text())

@@ -180,13 +180,15 @@ def inject_flight(source: Flight, processed: str | Path, sensor: str, kind: str,
     lines = {t: source.topics[t].lines for t in keep}
     lines[GROUND_TRUTH] = np.arange(2, len(times) - first + 2)
     t0 = min(int(v[0]) for v in t_ns.values())
-    new = {t: Topic(name, t, f"{name}-{t}.csv", (t_ns[t] - t0) * 1e-9, frames[t], lines[t])
-           for t in sorted(t_ns) if t not in source.topics or t == sig.topic}
-    # the other topics keep the source's frame, and so may share its parsed values:
-    # replace() passes the source topic's cache on, which the grid's other flights fill
-    new |= {t: replace(source.topics[t], flight=name, file=f"{name}-{t}.csv",
-                       t=(t_ns[t] - t0) * 1e-9) for t in t_ns if t not in new}
-    new = dict(sorted(new.items()))
+
+    def renamed(t: str) -> Topic:
+        if t in source.topics and t != sig.topic:
+            # the source's frame, so its parsed values too: replace() passes its cache on,
+            # and the grid's other flights from this source fill it
+            return replace(source.topics[t], flight=name, file=f"{name}-{t}.csv",
+                           t=(t_ns[t] - t0) * 1e-9)
+        return Topic(name, t, f"{name}-{t}.csv", (t_ns[t] - t0) * 1e-9, frames[t], lines[t])
+    new = {t: renamed(t) for t in sorted(t_ns)}
     files = {source.topics[t].file: f"{name}-{t}.csv" for t in keep}
     repairs = [files[r.split(":", 1)[0]] + ":" + r.split(":", 1)[1]
                for r in source.repairs if r.split(":", 1)[0] in files]
