@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from fractions import Fraction
 
 from scipy.special import ndtri
 
@@ -71,15 +72,20 @@ def mcnemar_exact(correct_a: Sequence[bool], correct_b: Sequence[bool]) -> dict:
     Only discordant flights carry information: ``b`` where only A is correct, ``c``
     where only B is. Under equal accuracy each discordant flight goes either way with
     probability 1/2, so the two-sided p-value is that of ``b`` in
-    :math:`\mathrm{Bin}(b + c, 1/2)` (1 without discordant flights)."""
+    :math:`\mathrm{Bin}(n, 1/2)`, :math:`n = b + c`. The law is symmetric, so the
+    outcomes as unlikely as ``b`` are the two tails beyond :math:`m = \min(b, c)`:
+
+    .. math:: p = \min\Bigl(1,\; 2^{1-n} \sum_{j=0}^{m} \binom{n}{j}\Bigr),
+
+    summed in integers and rounded once (1 without discordant flights). It is
+    ``scipy.stats.binomtest(b, n).pvalue`` without its float tails, or its import."""
     if len(correct_a) != len(correct_b):
         raise ValueError("McNemar needs the same flights for both methods")
     b = sum(1 for x, y in zip(correct_a, correct_b, strict=True) if x and not y)
     c = sum(1 for x, y in zip(correct_a, correct_b, strict=True) if y and not x)
-    from scipy.stats import binomtest  # ~0.5 s to import: only where tests are made
-
-    p = binomtest(b, b + c, 0.5).pvalue if b + c else 1.0
-    return {"only_a": b, "only_b": c, "p_value": float(min(1.0, p))}
+    n = b + c
+    tails = 2 * sum(math.comb(n, j) for j in range(min(b, c) + 1))
+    return {"only_a": b, "only_b": c, "p_value": min(1.0, float(Fraction(tails, 2**n)))}
 
 
 def _ratio(a: int, b: int) -> float:

@@ -1,13 +1,15 @@
 """Detectors: the streaming contract, the batch runner and the registry.
 
 A new method is one module defining a :class:`Detector` subclass plus one line in
-:data:`REGISTRY`; the contract test then checks it automatically. A detector kept in a
-package of its own registers through the entry-point group :data:`PLUGIN_GROUP`
-(``[project.entry-points."alfa_bench.methods"]`` in its ``pyproject.toml``, name =
-``"module:Class"``); once installed it is in :data:`REGISTRY` beside the built-in ones,
-a config run can name it, and the contract test covers it (``examples/alfa-cusum``).
+:data:`BUILTIN_ENTRIES` (name = ``"module:Class"``); the contract test then checks it
+automatically. A detector kept in a package of its own registers through the
+entry-point group :data:`PLUGIN_GROUP` (``[project.entry-points."alfa_bench.methods"]``
+in its ``pyproject.toml``, name = ``"module:Class"``); once installed it is in
+:data:`REGISTRY` beside the built-in ones, a config run can name it, and the contract
+test covers it (``examples/alfa-cusum``).
 """
 
+import importlib
 import inspect
 from importlib.metadata import entry_points
 
@@ -19,32 +21,26 @@ from .base import (
     run_detector,
     skipped_channels,
 )
-from .emulation_oracle import EmulationOracle
-from .end_of_flight import EndOfFlight
-from .ffrls_monitor import FfRlsMonitor
-from .glrt_residuals import GlrtResiduals
-from .kalman_okid import KalmanOkid
-from .learned_fusion import LearnedFusion
-from .residual_bank import ResidualBank
-from .rls_arx_zscore import RlsArxZscore
 
-__all__ = ["BUILTIN", "PLUGIN_GROUP", "REGISTRY", "Detector", "NotFittedError", "Trace",
-           "fault_free_segments", "make_detector", "plugins", "run_detector",
-           "skipped_channels"]
+__all__ = ["BUILTIN", "BUILTIN_ENTRIES", "PLUGIN_GROUP", "REGISTRY", "Detector",
+           "NotFittedError", "Trace", "fault_free_segments", "make_detector", "plugins",
+           "run_detector", "skipped_channels"]
 
 #: the entry-point group third-party detectors register under
 PLUGIN_GROUP = "alfa_bench.methods"
 
-#: the detectors that ship with alfa-bench
-BUILTIN: dict[str, type[Detector]] = {
-    "rls_arx_zscore": RlsArxZscore,
-    "glrt_residuals": GlrtResiduals,
-    "ffrls_monitor": FfRlsMonitor,
-    "kalman_okid": KalmanOkid,
-    "residual_bank": ResidualBank,
-    "learned_fusion": LearnedFusion,
-    "emulation_oracle": EmulationOracle,
-    "end_of_flight": EndOfFlight,
+#: the detectors that ship with alfa-bench, each as an entry point's ``"module:Class"``.
+#: They are imported when BUILTIN or REGISTRY is first read: the detector modules import
+#: numba and scipy, which a job that only reads traces (Trace) has no use for.
+BUILTIN_ENTRIES = {
+    "rls_arx_zscore": "rls_arx_zscore:RlsArxZscore",
+    "glrt_residuals": "glrt_residuals:GlrtResiduals",
+    "ffrls_monitor": "ffrls_monitor:FfRlsMonitor",
+    "kalman_okid": "kalman_okid:KalmanOkid",
+    "residual_bank": "residual_bank:ResidualBank",
+    "learned_fusion": "learned_fusion:LearnedFusion",
+    "emulation_oracle": "emulation_oracle:EmulationOracle",
+    "end_of_flight": "end_of_flight:EndOfFlight",
 }
 
 
@@ -55,7 +51,7 @@ def plugins() -> dict[str, type[Detector]]:
     found = {}
     for ep in entry_points(group=PLUGIN_GROUP):
         where = f"entry point {ep.name} = {ep.value!r} (group {PLUGIN_GROUP})"
-        if ep.name in BUILTIN:
+        if ep.name in BUILTIN_ENTRIES:
             raise ImportError(f"{where} would shadow the built-in detector {ep.name!r}")
         cls = ep.load()
         if not (isinstance(cls, type) and issubclass(cls, Detector)):
@@ -64,16 +60,34 @@ def plugins() -> dict[str, type[Detector]]:
     return found
 
 
-#: every detector a config run can name: the built-in ones and the installed plugins
-REGISTRY: dict[str, type[Detector]] = {**BUILTIN, **plugins()}
+def _builtin() -> dict[str, type[Detector]]:
+    found = {}
+    for name, value in BUILTIN_ENTRIES.items():
+        module, cls = value.split(":")
+        found[name] = getattr(importlib.import_module(f".{module}", __name__), cls)
+    return found
+
+
+def __getattr__(name: str):
+    """``BUILTIN``: the detectors that ship with alfa-bench; ``REGISTRY``: every detector
+    a config run can name, the built-in ones and the installed plugins. Each is built
+    once, on first use."""
+    if name == "BUILTIN":
+        globals()["BUILTIN"] = _builtin()
+    elif name == "REGISTRY":
+        globals()["REGISTRY"] = {**__getattr__("BUILTIN"), **plugins()}
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return globals()[name]
 
 
 def make_detector(name: str, params: dict | None = None) -> Detector:
     """Build the registered detector ``name`` with ``params``."""
+    registry = __getattr__("REGISTRY")
     try:
-        cls = REGISTRY[name]
+        cls = registry[name]
     except KeyError:
-        raise KeyError(f"unknown detector {name!r}; registered: {sorted(REGISTRY)}") from None
+        raise KeyError(f"unknown detector {name!r}; registered: {sorted(registry)}") from None
     params = dict(params or {})
     signature = inspect.signature(cls.__init__).parameters
     for key, value in params.items():

@@ -58,6 +58,14 @@ def test_mcnemar_counts_only_the_discordant_flights():
         mcnemar_exact([True], [True, False])
 
 
+def test_mcnemar_is_scipys_binomial_test():
+    for b in range(40):
+        for c in range(40):
+            p = mcnemar_exact([True] * b + [False] * c, [False] * b + [True] * c)["p_value"]
+            expected = binomtest(b, b + c, 0.5).pvalue if b + c else 1.0
+            assert p == pytest.approx(expected, rel=1e-12, abs=0), (b, c)
+
+
 def test_blocks_follow_the_role_and_the_inputs():
     assert block({"role": "reference", "reads_actuators": True}) == "reference"
     assert block({"role": "method", "reads_actuators": True}) == "reads actuators"
