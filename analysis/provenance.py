@@ -60,22 +60,30 @@ def module_sources(cls: type) -> list[str]:
     todo = [cls.__module__]
     while todo:
         name = todo.pop()
-        if name in found:
-            continue
-        module = importlib.import_module(name)
-        found[name] = module.__file__
-        for node in ast.walk(ast.parse(Path(module.__file__).read_text())):
-            if isinstance(node, ast.Import):
-                todo += [a.name for a in node.names if a.name.startswith("alfa_bench")]
-            elif isinstance(node, ast.ImportFrom):
-                base = ("." * node.level + (node.module or "")) if node.level else node.module
-                base = importlib.util.resolve_name(base, module.__package__)
-                if not base.startswith("alfa_bench"):
-                    continue
-                names = [] if node.module is None else [base]
-                todo += [m for m in (*names, *(f"{base}.{a.name}" for a in node.names))
-                         if m == base or _is_module(m)]
+        if name not in found:
+            found[name], imports = _imports(name)
+            todo += imports
     return sorted(found.values())
+
+
+@cache
+def _imports(name: str) -> tuple[str, list[str]]:
+    """The source file of module ``name`` and the ``alfa_bench`` modules it imports.
+    Cached: the workflow asks once per method, and most share their modules."""
+    module = importlib.import_module(name)
+    found = []
+    for node in ast.walk(ast.parse(Path(module.__file__).read_text())):
+        if isinstance(node, ast.Import):
+            found += [a.name for a in node.names if a.name.startswith("alfa_bench")]
+        elif isinstance(node, ast.ImportFrom):
+            base = ("." * node.level + (node.module or "")) if node.level else node.module
+            base = importlib.util.resolve_name(base, module.__package__)
+            if not base.startswith("alfa_bench"):
+                continue
+            names = [] if node.module is None else [base]
+            found += [m for m in (*names, *(f"{base}.{a.name}" for a in node.names))
+                      if m == base or _is_module(m)]
+    return module.__file__, found
 
 
 def _is_module(name: str) -> bool:
