@@ -39,32 +39,36 @@ def write_trace(trace: Trace, path: str | Path, provenance: dict) -> None:
     write_npz(path, arrays, compress=True)
 
 
-def read_trace(path: str | Path) -> Trace:
-    """The :class:`~alfa_bench.methods.Trace` stored at ``path``, alarms included."""
+def read_trace(path: str | Path, probes: bool = True) -> Trace:
+    """The :class:`~alfa_bench.methods.Trace` stored at ``path``, alarms included; its
+    probes (intermediates) only with ``probes``: they are most of the file, and only
+    the recordings show them."""
     with np.load(path, allow_pickle=False) as z:
         score, threshold = z["score"], z["threshold"]
         with np.errstate(invalid="ignore"):
             alarm = score > threshold
-        probes = z["probes"]
+        values = z["probes"] if probes else None
         return Trace(t=z["t"], score=score, alarm=alarm,
                      channels=tuple(str(c) for c in z["channels"]), threshold=threshold,
-                     probes={str(n): probes[:, i] for i, n in enumerate(z["probe_names"])})
+                     probes={} if values is None else
+                     {str(n): values[:, i] for i, n in enumerate(z["probe_names"])})
 
 
-def read_traces(folders) -> Mapping[tuple[str, str], Trace]:
+def read_traces(folders, probes: bool = True) -> Mapping[tuple[str, str], Trace]:
     """Every trace in the given ``results/traces/{method}`` folders, by (method, flight),
-    each read from its file when looked up and not kept, so that memory does not grow
-    with the corpus (at 16 times ALFA's flights, reading them all took 4.4 GB)."""
+    each read from its file (with its probes if ``probes``) when looked up and not kept,
+    so that memory does not grow with the corpus (at 16 times ALFA's flights, reading
+    them all took 4.4 GB)."""
     return _Traces({(Path(d).name, p.stem): p
-                    for d in folders for p in sorted(Path(d).glob("*.npz"))})
+                    for d in folders for p in sorted(Path(d).glob("*.npz"))}, probes)
 
 
 class _Traces(Mapping[tuple[str, str], Trace]):
-    def __init__(self, paths: dict[tuple[str, str], Path]):
-        self.paths = paths
+    def __init__(self, paths: dict[tuple[str, str], Path], probes: bool):
+        self.paths, self.probes = paths, probes
 
     def __getitem__(self, key: tuple[str, str]) -> Trace:
-        return read_trace(self.paths[key])
+        return read_trace(self.paths[key], self.probes)
 
     def __contains__(self, key) -> bool:         # Mapping's would read the file
         return key in self.paths

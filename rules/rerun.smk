@@ -1,4 +1,6 @@
 rule rerun_logs:
+    # the longest jobs start first, and the short ones fill the other cores
+    priority: 2
     input:
         manifest="data/flights.csv",
         cache="results/cache",

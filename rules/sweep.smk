@@ -1,4 +1,6 @@
 rule sweep:
+    # among the jobs ready, first: the figures and the paper wait on it
+    priority: 2
     input:
         manifest="data/flights.csv",
         detections=expand("results/detections/{method}", method=METHODS),
@@ -35,6 +37,8 @@ rule figures:
 
 # apart from the other figures, so that the two draw in parallel
 rule flight_figures:
+    # the longest jobs start first, and the short ones fill the other cores
+    priority: 2
     input:
         manifest="data/flights.csv",
         detections=expand("results/detections/{method}", method=METHODS),

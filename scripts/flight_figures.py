@@ -12,7 +12,7 @@ from alfa_bench.data import read_manifest
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 records = read_records(sm.input.detections)
-traces = read_traces(sm.input.traces)
+traces = read_traces(sm.input.traces, probes=False)
 prov = run_provenance(sm.config, read_manifest(sm.input.manifest))
 methods = list(dict.fromkeys(r["method"] for r in records))
 drawers = {}    # one per set of methods: a flight a method excluded is drawn without it

@@ -12,8 +12,8 @@ sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 manifest = read_manifest(sm.input.manifest)
 deadline = float(sm.params.deadline_s)
-table = per_flight_table(read_records(sm.input.detections), read_traces(sm.input.traces),
-                         manifest, deadline)
+table = per_flight_table(read_records(sm.input.detections),
+                         read_traces(sm.input.traces, probes=False), manifest, deadline)
 table.to_csv(sm.output.csv, index=False)
 Path(sm.output.md).write_text(per_flight_markdown(table, deadline))
 prov = run_provenance(sm.config, manifest)

@@ -10,7 +10,8 @@ from alfa_bench.data import read_manifest
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 manifest = read_manifest(sm.input.manifest)
-sweep = sweep_table(read_records(sm.input.detections), read_traces(sm.input.traces), manifest,
-                    sm.params.subsets, float(sm.params.deadline_s))
+sweep = sweep_table(read_records(sm.input.detections),
+                    read_traces(sm.input.traces, probes=False), manifest, sm.params.subsets,
+                    float(sm.params.deadline_s))
 sweep.to_csv(sm.output[0], index=False)
 stamp(sm.output[0], run_provenance(sm.config, manifest))

@@ -24,6 +24,11 @@ def test_round_trip_keeps_every_value_and_rebuilds_alarms(one_flight, tmp_path):
     for name in trace.probes:
         np.testing.assert_array_equal(back.probes[name], trace.probes[name])
     assert set(read_traces([tmp_path / "rls"])) == {("rls", "f")}
+    bare = read_trace(path, probes=False)
+    assert trace.probes and bare.probes == {}
+    np.testing.assert_array_equal(bare.score, trace.score)
+    np.testing.assert_array_equal(bare.alarm, trace.alarm)
+    assert read_traces([tmp_path / "rls"], probes=False)["rls", "f"].probes == {}
 
 
 def test_the_same_trace_gives_the_same_bytes(one_flight, tmp_path):
