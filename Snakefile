@@ -29,7 +29,6 @@ rule all:
         rules.leakage.output,
         rules.runtime.output,
         rules.sweep.output,
-        rules.figures.output,
         rules.flight_figures.output,
         rules.rerun_logs.output,
         rules.paper_sources.output,

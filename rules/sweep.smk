@@ -1,41 +1,24 @@
 rule sweep:
-    # among the jobs ready, first: the figures and the paper wait on it
+    # among the jobs ready, first: the paper waits on it
     priority: 2
     input:
         manifest="data/flights.csv",
         detections=expand("results/detections/{method}", method=METHODS),
         traces=expand("results/traces/{method}", method=METHODS),
     output:
-        report("results/tables/sweep.csv", category="Threshold sweeps"),
+        csv=report("results/tables/sweep.csv", category="Threshold sweeps"),
+        figure=report("results/figures/sweep.png", caption="../report/sweep.rst",
+                      category="Threshold sweeps"),
     params:
         subsets=config["subsets"],
         deadline_s=config["scoring"]["deadline_s"],
+        subset=config["figures"]["subset"],
     log:
         "results/logs/sweep.log",
     script:
         "../scripts/sweep.py"
 
 
-rule figures:
-    input:
-        manifest="data/flights.csv",
-        sweep="results/tables/sweep.csv",
-        detections=expand("results/detections/{method}", method=METHODS),
-    output:
-        sweep=report("results/figures/sweep.png", caption="../report/sweep.rst",
-                     category="Threshold sweeps"),
-        detection_time=report("results/figures/detection_time.png",
-                              caption="../report/detection_time.rst",
-                              category="Detection times"),
-    params:
-        subset=config["figures"]["subset"],
-    log:
-        "results/logs/figures.log",
-    script:
-        "../scripts/figures.py"
-
-
-# apart from the other figures, so that the two draw in parallel
 rule flight_figures:
     # the longest jobs start first, and the short ones fill the other cores
     priority: 2

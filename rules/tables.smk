@@ -63,6 +63,9 @@ rule deadline:
         md=report("results/tables/deadline.md", category="Tables"),
         figure=report("results/figures/deadline.png", caption="../report/deadline.rst",
                       category="Detection times"),
+        detection_time=report("results/figures/detection_time.png",
+                              caption="../report/detection_time.rst",
+                              category="Detection times"),
     params:
         subsets=config["subsets"],
         deadlines_s=config["scoring"]["deadlines_s"],

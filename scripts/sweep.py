@@ -1,6 +1,8 @@
-"""Snakemake script: threshold sweeps of every method from its stored traces."""
+"""Snakemake script: threshold sweeps of every method from its stored traces, as a
+table and a figure."""
 
 from alfa_bench.analysis import read_records
+from alfa_bench.analysis.figures import sweep_figure
 from alfa_bench.analysis.logs import log_to
 from alfa_bench.analysis.provenance import run_provenance, stamp
 from alfa_bench.analysis.sweep import sweep_table
@@ -13,5 +15,8 @@ manifest = read_manifest(sm.input.manifest)
 sweep = sweep_table(read_records(sm.input.detections),
                     read_traces(sm.input.traces, probes=False), manifest, sm.params.subsets,
                     float(sm.params.deadline_s))
-sweep.to_csv(sm.output[0], index=False)
-stamp(sm.output[0], run_provenance(sm.config, manifest))
+sweep.to_csv(sm.output.csv, index=False)
+sweep_figure(sweep, sm.params.subset, sm.output.figure)
+prov = run_provenance(sm.config, manifest)
+for path in sm.output:
+    stamp(path, prov)
