@@ -200,7 +200,9 @@ class FlightFigure:
             panel["first"].set_visible(first is not None and lo <= first <= hi)
             panel["first"].set_xdata([first, first])
             panel["note"].set_text("no alarm" if first is None else f"first alarm {first:.1f} s")
-            panel["ax"].set_xlim(lo, hi)
+        # the panels share x, so the last panel's span holds for all: set once, since
+        # each call updates every panel
+        self.panels[-1]["ax"].set_xlim(lo, hi)
         self.title.set_text(f"{flight}\nscore / threshold (dashed: alarm level; grey: "
                             "fault; red line: first alarm)")
         canvas = self.fig.canvas
