@@ -170,7 +170,8 @@ def inject_flight(source: Flight, processed: str | Path, sensor: str, kind: str,
                                  (times[first:] - onset_ns) * 1e-9, magnitude, span, rng)
     frame = topic.frame.copy(deep=False)
     frame[sig.column] = corrupted
-    frames = {t: (frame if t == sig.topic else source.topics[t].frame) for t in keep}
+    # the other topics are the source's, frames and all (renamed, below)
+    frames = {sig.topic: frame}
     rows = np.zeros(len(times) - first, dtype=np.intp)
     gt = pd.DataFrame({"field.data": np.ones(len(rows), np.int64),
                        "field.sensor": _text(sensor).take(rows),
