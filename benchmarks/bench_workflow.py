@@ -18,6 +18,7 @@ Each case runs in a fresh temporary working directory; prints a Markdown table.
 from __future__ import annotations
 
 import argparse
+import copy
 import os
 import re
 import subprocess
@@ -74,6 +75,7 @@ def main() -> None:
     args = ap.parse_args()
     processed = Path(os.environ["ALFA_DIR"]) / "processed"
     base = yaml.safe_load((ROOT / "config/config.yaml").read_text())
+    found = sum(1 for p in processed.iterdir() if p.is_dir())
     print("| case | flights found | method runs | wall s |")
     print("|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
@@ -93,22 +95,20 @@ def main() -> None:
                     "false_alarm": 1e-4 * (i + 1)}} for i in range(k)}}
             config = tmp / f"config{k}.yaml"
             config.write_text(yaml.safe_dump(swept))
-            n = sum(1 for p in processed.iterdir() if p.is_dir())
             wall, _ = run(processed.parent, config, tmp / f"settings{k}")
-            print(f"| glrt_arx settings x{k} | {n} | {len(swept['methods'])} | {wall:.1f} |",
+            print(f"| glrt_arx settings x{k} | {found} | {len(swept['methods'])} | {wall:.1f} |",
                   flush=True)
         if args.changed:
-            n = sum(1 for p in processed.iterdir() if p.is_dir())
             config = tmp / "changed.yaml"
             config.write_text(yaml.safe_dump(base))
             wall, _ = run(processed.parent, config, tmp / "changed")
-            print(f"| all, before the change | {n} | {len(base['methods'])} | {wall:.1f} |")
-            changed = yaml.safe_load(config.read_text())
+            print(f"| all, before the change | {found} | {len(base['methods'])} | {wall:.1f} |")
+            changed = copy.deepcopy(base)
             changed["methods"]["glrt_arx_chi2"]["params"]["false_alarm"] /= 2
             config.write_text(yaml.safe_dump(changed))
             wall, jobs = run(processed.parent, config, tmp / "changed")
             ran = ", ".join(f"{rule} {k}" for rule, k in sorted(jobs.items()))
-            print(f"| all, after glrt_arx_chi2 changed ({ran}) | {n} | "
+            print(f"| all, after glrt_arx_chi2 changed ({ran}) | {found} | "
                   f"{len(base['methods'])} | {wall:.1f} |", flush=True)
 
 
