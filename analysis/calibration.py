@@ -2,14 +2,17 @@
 
 Each fold holds out one group of flights (a day, by default, since flights of one
 day share the aircraft's trim, wind and the segments of one recording) and
-calibrates on the fault-free data of every other flight with ground truth.
+calibrates on the fault-free data of every other flight with ground truth (or, for a
+supervised detector, on those flights whole, with their labels).
+:func:`check_held_out` checks, before every fit, that no segment comes from the
+group scored.
 """
 
 from __future__ import annotations
 
 import pandas as pd
 
-__all__ = ["GROUPINGS", "folds", "groups_of"]
+__all__ = ["GROUPINGS", "HeldOutError", "check_held_out", "folds", "groups_of"]
 
 #: manifest column that defines a group
 GROUPINGS = {"date": "date", "flight": "flight"}
@@ -49,3 +52,19 @@ def groups_of(scored: pd.DataFrame, train: pd.DataFrame, group_by: str) -> pd.Se
         raise ValueError(f"injected flights' sources are not among the calibration "
                          f"flights: {unknown}")
     return own.where(~injected, source.map(of_source))
+
+
+class HeldOutError(RuntimeError):
+    """A fit was about to see a flight of the group it scores: a bug, never data."""
+
+
+def check_held_out(segments, fold: str, scored: list[str], group: dict[str, str]) -> None:
+    """Raise :class:`HeldOutError` if a segment (anything with a ``flight``) comes from
+    a flight of ``scored`` or of group ``fold`` (``group`` maps flights to groups)."""
+    seen = {seg.flight for seg in segments}
+    inside = sorted(f for f in seen if f in set(scored) or group.get(f) == fold)
+    unknown = sorted(seen - set(group))
+    if inside or unknown:
+        what = (f"flights of the scored group: {inside}" if inside else
+                f"flights of no known group: {unknown}")
+        raise HeldOutError(f"fold {fold}: calibration would see {what}")

@@ -35,11 +35,12 @@ from alfa_bench.methods import (
     Detector,
     Trace,
     fault_free_segments,
+    labelled_segments,
     make_detector,
     run_detector,
 )
 
-from .calibration import folds, groups_of
+from .calibration import GROUPINGS, check_held_out, folds, groups_of
 from .isolation import isolate
 from .provenance import provenance, read_table, run_provenance, stamp
 from .scoring import flight_outcome
@@ -60,7 +61,9 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
 
     A calibrated method is fitted per fold on the other groups' flights of
     ``calibrate_on`` (default ``manifest``): injected flights are scored by the
-    model of their source's group, fitted on real flights only.
+    model of their source's group, fitted on real flights only. A supervised one gets
+    those flights whole, with their labels. Before each fit, no segment may come from
+    the group scored (:func:`~.calibration.check_held_out`, which stops the run).
 
     With ``failures`` None, a flight that cannot be read raises its
     :class:`~alfa_bench.data.AlfaDataError`; with a list, the flight is skipped and a
@@ -109,25 +112,31 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
     except ValueError as e:
         uncalibrated([f for names in scored_by_fold.values() for f in names], e)
         return
+    group = dict(zip(train["flight"], train[GROUPINGS[calibration["group_by"]]].astype(str),
+                     strict=True))
     for fold, (_, training) in by_fold.items():
         scored = scored_by_fold.pop(fold, [])
         if not scored:
             continue
-        segments = {f: guarded("calibration", f, lambda f=f: fault_free_segments(
-            detector, [flights[f]], calibration["margin_s"])) for f in training}
+        segments = {f: guarded("calibration", f, lambda f=f: (
+            labelled_segments(detector, [flights[f]]) if detector.supervised else
+            fault_free_segments(detector, [flights[f]], calibration["margin_s"])))
+            for f in training}
         readable = [f for f in training if segments[f] is not None]
         dead = {f: list(d) for f in readable
                 if (d := not_measured(flights[f], detector.signals()))}
         used = [f for f in readable if f not in dead]
+        data = [s for f in used for s in segments[f]]
+        check_held_out(data, fold, scored, group)
         try:
-            detector.fit([s for f in used for s in segments[f]])
+            detector.fit(data)
         except ValueError as e:
             uncalibrated(scored, ValueError(f"fold {fold} ({len(used)} calibration flights): "
                                             f"{e}"))
             continue
         log.info("%s: fold %s fitted on %d flights", method, fold, len(used))
         info = {**calibration, "fold": fold, "flights": used, "not_measured": dead,
-                "fitted": detector.fitted()}
+                "supervised": detector.supervised, "fitted": detector.fitted()}
         for name in scored:
             if (out := run(name, info)) is not None:
                 yield out

@@ -133,17 +133,21 @@ class Sampled:
     fresh : ndarray of bool, shape (n, m)
         True where the value comes from a new measurement.
     names : tuple of str
+    flight : str
+        The flight sampled: what calibration checks to keep a scored flight out of a fit.
     """
 
     t: np.ndarray
     x: np.ndarray
     fresh: np.ndarray
     names: tuple[str, ...]
+    flight: str = ""
 
     def before(self, t_s: float) -> Sampled:
         """The grid steps strictly before ``t_s``."""
         n = int(np.searchsorted(self.t, t_s, side="left"))
-        return Sampled(t=self.t[:n], x=self.x[:n], fresh=self.fresh[:n], names=self.names)
+        return Sampled(t=self.t[:n], x=self.x[:n], fresh=self.fresh[:n], names=self.names,
+                       flight=self.flight)
 
 
 def series(flight: Flight, name: str) -> tuple[np.ndarray, np.ndarray]:
@@ -214,7 +218,7 @@ def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float,
         last_change = np.maximum.accumulate(np.where(changed, np.arange(measured.size), 0))
         source = last_change[row]
         fresh[:, j] = np.r_[True, source[1:] != source[:-1]]
-    return Sampled(t=t, x=x, fresh=fresh, names=names)
+    return Sampled(t=t, x=x, fresh=fresh, names=names, flight=flight.id)
 
 
 def _check_hold(flight: Flight, tp, t: np.ndarray, max_hold_s: float) -> None:

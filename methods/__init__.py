@@ -15,16 +15,18 @@ from importlib.metadata import entry_points
 
 from .base import (
     Detector,
+    Labelled,
     NotFittedError,
     Trace,
     fault_free_segments,
+    labelled_segments,
     run_detector,
     skipped_channels,
 )
 
-__all__ = ["BUILTIN", "BUILTIN_ENTRIES", "PLUGIN_GROUP", "REGISTRY", "Detector",
-           "NotFittedError", "Trace", "fault_free_segments", "make_detector", "plugins",
-           "run_detector", "skipped_channels"]
+__all__ = ["BUILTIN", "BUILTIN_ENTRIES", "PLUGIN_GROUP", "REGISTRY", "Detector", "Labelled",
+           "NotFittedError", "Trace", "fault_free_segments", "labelled_segments",
+           "make_detector", "plugins", "run_detector", "skipped_channels"]
 
 #: the entry-point group third-party detectors register under
 PLUGIN_GROUP = "alfa_bench.methods"

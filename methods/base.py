@@ -15,6 +15,13 @@ pre-fault parts of the others, never the flight to be scored) and sets its fitte
 attributes (ending in ``_``, kept by :meth:`~Detector.reset`);
 :meth:`~Detector.fitted` reports them for the detection record.
 
+A *supervised* detector (``supervised = True``, and calibrated) learns from labelled
+flights instead: its :meth:`~Detector.fit` receives :class:`Labelled` segments
+(:func:`labelled_segments`), whole flights of the other groups with their onset and
+fault class, so it may learn what a fault looks like. It says so: the tables'
+calibration column reads ``supervised``. Neither kind ever sees a flight of the group
+it scores (:func:`alfa_bench.analysis.calibration.check_held_out`).
+
 A signal that is not measured on a flight (constant over all of it, like measured
 airspeed from 2018-09-11 on) is never modelled: :func:`run_detector` skips the
 channels that score it, or every channel when a model input is dead
@@ -33,8 +40,8 @@ import numpy as np
 
 from alfa_bench.data import Flight, Sampled, not_measured, sample
 
-__all__ = ["Detector", "NotFittedError", "Trace", "fault_free_segments", "run_detector",
-           "skipped_channels"]
+__all__ = ["Detector", "Labelled", "NotFittedError", "Trace", "fault_free_segments",
+           "labelled_segments", "run_detector", "skipped_channels"]
 
 log = logging.getLogger(__name__)
 
@@ -54,6 +61,9 @@ class Detector(ABC):
     rate_hz: float
     #: whether :meth:`fit` must see fault-free data before the detector can run
     calibrated: bool = False
+    #: whether :meth:`fit` learns from labelled flights (:class:`Labelled` segments)
+    #: rather than from fault-free data alone; only with ``calibrated``
+    supervised: bool = False
     #: whether each output depends on the data up to then only; a detector that is
     #: not may serve only as a reference row (``role: reference`` in the config)
     causal: bool = True
@@ -76,9 +86,10 @@ class Detector(ABC):
         """Per channel, the measured signal whose behaviour it scores: what the
         channel isolates when it alarms first."""
 
-    def fit(self, segments: list[Sampled]) -> Detector:
+    def fit(self, segments: list[Sampled] | list[Labelled]) -> Detector:
         """Learn from fault-free ``segments`` (sampled with :meth:`signals` at
-        :attr:`rate_hz`); return self. Uncalibrated detectors learn nothing here."""
+        :attr:`rate_hz`), or from :class:`Labelled` ones if :attr:`supervised`; return
+        self. Uncalibrated detectors learn nothing here."""
         return self
 
     def fitted(self) -> dict:
@@ -140,6 +151,29 @@ class Detector(ABC):
             Per channel; NaN while the channel is not yet armed.
         alarm : ndarray of bool, shape (c,)
         """
+
+
+@dataclass(frozen=True)
+class Labelled:
+    """A whole flight for a supervised :meth:`Detector.fit`: its samples and its label.
+
+    Attributes
+    ----------
+    sampled : Sampled
+        The flight, sampled as the detector reads it.
+    onset_s : float or None
+        Fault onset on the flight clock; None for a fault-free flight.
+    fault_class : str
+        ``none`` for a fault-free flight.
+    """
+
+    sampled: Sampled
+    onset_s: float | None
+    fault_class: str
+
+    @property
+    def flight(self) -> str:
+        return self.sampled.flight
 
 
 @dataclass(frozen=True)
@@ -241,4 +275,21 @@ def fault_free_segments(detector: Detector, flights: list[Flight],
             s = s.before(flight.fault.onset_s - margin_s)
         if s.t.size:
             segments.append(s)
+    return segments
+
+
+def labelled_segments(detector: Detector, flights: list[Flight]) -> list[Labelled]:
+    """The whole of each of ``flights`` with its label, for a supervised ``detector``.
+    As for :func:`fault_free_segments`, a flight without ground truth is refused and
+    one that does not measure a signal of the detector gives nothing (logged)."""
+    segments = []
+    for flight in flights:
+        if flight.fault is None:
+            raise ValueError(f"flight {flight.id} has no ground truth, so it cannot train")
+        dead = not_measured(flight, detector.signals())
+        if dead:
+            log.info("%s left out of training: %s not measured", flight.id, list(dead))
+            continue
+        segments.append(Labelled(sample(flight, detector.signals(), detector.rate_hz),
+                                 flight.fault.onset_s, flight.fault.fault_class))
     return segments

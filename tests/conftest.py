@@ -6,6 +6,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
 
+from alfa_bench.data import build_manifest, load_flight  # noqa: E402
 from synthetic import write_corpus, write_flight  # noqa: E402
 
 REAL_ALFA = Path(os.environ["ALFA_DIR"]) if os.environ.get("ALFA_DIR") else None
@@ -32,6 +33,18 @@ def corpus(tmp_path_factory) -> Path:
     processed = tmp_path_factory.mktemp("alfa") / "processed"
     write_corpus(processed)
     return processed
+
+
+@pytest.fixture(scope="session")
+def corpus_manifest(corpus):
+    """The corpus's manifest (read-only use)."""
+    return build_manifest(corpus)
+
+
+@pytest.fixture(scope="session")
+def corpus_flights(corpus, corpus_manifest) -> dict:
+    """The corpus's flights, loaded, by name (read-only use)."""
+    return {f: load_flight(corpus / f) for f in corpus_manifest["flight"]}
 
 
 @pytest.fixture
