@@ -21,8 +21,9 @@ import pandas as pd
 from alfa_bench.data import subset_flights
 
 from .figures import BLOCK_STYLES, colors, plt, save
+from .render import fmt, markdown
 from .scoring import wilson_interval
-from .tables import BLOCKS, block, fmt, markdown
+from .tables import BLOCKS, block
 
 __all__ = ["deadline_figure", "deadline_markdown", "deadline_table", "false_alarm_time"]
 

@@ -24,8 +24,8 @@ import numpy as np
 import pandas as pd
 
 from .figures import colors, plt, save
+from .render import fmt, markdown
 from .scoring import flight_outcome
-from .tables import fmt, markdown
 
 __all__ = ["detectability_figure", "detectability_markdown", "detectability_table"]
 

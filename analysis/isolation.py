@@ -25,10 +25,10 @@ from alfa_bench.data import SIGNALS
 from alfa_bench.data.inject import SENSORS
 from alfa_bench.methods import Trace
 
-from .tables import fmt, markdown
+from .render import fmt, markdown
 
 __all__ = ["MISSED", "SENSOR_ACTUATOR", "confusion", "isolate", "isolation_markdown",
-           "isolation_rows", "measured_sensor"]
+           "isolation_rows", "measured_sensor", "named_class", "names_class"]
 
 _ACTUATORS = ["engine", "aileron", "elevator", "rudder"]
 
@@ -66,6 +66,20 @@ def isolate(trace: Trace, onset_s: float, outputs: dict[str, str]) -> str | None
         return measured_sensor(outputs[trace.channels[int(np.argmax(r))]])
     except KeyError:
         return None
+
+
+def named_class(record: dict) -> str | None:
+    """The actuator class that a record's first alarm from the onset points at: the one
+    acting on the axis its isolated sensor measures (:data:`SENSOR_ACTUATOR`). None where
+    it missed, or alarmed on a channel that scores no sensor or no control axis."""
+    return SENSOR_ACTUATOR.get(record.get("isolated_sensor") or MISSED)
+
+
+def names_class(record: dict) -> bool:
+    """Whether that class is the flight's fault class (either of a combined one): a
+    detection by a channel that can see the fault, not by a model of another axis."""
+    named = named_class(record)
+    return named is not None and named in record["fault_class"].split("+")
 
 
 def _ratio_row(trace: Trace, k: int) -> np.ndarray:

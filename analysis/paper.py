@@ -14,10 +14,14 @@ scored with the deadline: ``precision:<m>:<s>``, ``recall:<m>:<s>``,
 ``meandet:<m>:<s>``, ``maxdet:<m>:<s>`` (s); by the paper's rule:
 ``accuracypaper:<m>:<s>``, ``recallpaper:<m>:<s>`` (%); ``falsealarms:<m>:<s>`` ("k of
 n" fault-free flights), ``best:<s>`` and ``bestaccuracy:<s>`` (the best honest method),
+``bestdetected:<s>`` and ``bestfalsealarms:<s>`` (its faults detected in time and its
+fault-free flights alarmed), ``primary`` (the headline subset's name),
 ``tied:<s>`` (the runs the exact McNemar test cannot tell apart from it),
 ``recallnofa:<m>:<s>`` (the best recall of the threshold sweep with no false alarm on
 any flight, %), ``leak:<sig>:<c>`` ("k of n" flights on which the signal goes flat at
-onset) and ``leakchance:<sig>:<c>`` (its larger chance rate, %), ``classdetected:<m>:<s>:<c>``
+onset), ``leakchance:<sig>:<c>`` (its larger chance rate, %), ``step:<sig>:<c>:<e>``
+("k of n" flights on which it steps at onset, ``<e>`` ``emr`` or ``noemr``: with or
+without an emergency trajectory), ``classdetected:<m>:<s>:<c>``
 ("k of n" faults of class ``c`` detected in time; "n/a" where the subset has none);
 from the per-flight table (:mod:`.per_flight`, all labelled flights), in units of the
 threshold: ``marginmax:<m>:<c>`` and ``marginmin:<m>:<c>`` (the largest and smallest
@@ -45,7 +49,8 @@ import pandas as pd
 from alfa_bench.data import SIGNALS
 
 from .reference import ICRA2019_SUMMARY
-from .tables import FAULT_ORDER, latex_escape
+from .render import latex_escape
+from .tables import FAULT_ORDER
 
 __all__ = ["latex_macros", "latex_keys", "paper_numbers", "render_markdown", "sensor_numbers"]
 
@@ -71,11 +76,13 @@ _PER_RUN = ("precision", "recall", "accuracy", "accuracypaper", "recallpaper", "
 def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.DataFrame,
                   by_fault: pd.DataFrame | None = None,
                   per_flight: pd.DataFrame | None = None,
-                  methods=(), subsets=(), sensors: dict | None = None) -> dict[str, str]:
+                  methods=(), subsets=(), sensors: dict | None = None,
+                  primary: str | None = None) -> dict[str, str]:
     """Every quotable number, as text, by key (see the module docstring). A configured
     run (``methods``) with no score on a subset (``subsets``), because every flight of
     it was excluded, quotes "n/a". ``sensors`` holds the ``detectability``,
-    ``isolation_sensors`` and ``isolation_actuators`` tables."""
+    ``isolation_sensors`` and ``isolation_actuators`` tables; ``primary`` is the
+    headline subset."""
     out = {f"{k}:{m}:{s}": "n/a" for k in _PER_RUN for m in methods for s in subsets}
     out |= {f"paper:{k}": (_pct if k in ("precision", "recall", "accuracy") else _sec)(
         ICRA2019_SUMMARY[key])
@@ -98,33 +105,30 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.Dat
         out[f"maxdet:{m}:{s}"] = _sec(r["max_detection_s"])
         out[f"falsealarms:{m}:{s}"] = (f"{r['fault_free_false_alarms']} of "
                                        f"{r['fault_free_flights']}")
+    out["primary"] = primary or "none"
     for s, table in comparison.groupby("subset", sort=False):
         best = table[table["rank"] == 1]
         out[f"best:{s}"] = best["method"].iloc[0] if len(best) else "none"
         out[f"bestaccuracy:{s}"] = _pct(best["accuracy"].iloc[0]) if len(best) else "n/a"
+        out[f"bestdetected:{s}"] = (out[f"detected:{best['method'].iloc[0]}:{s}"]
+                                    if len(best) else "n/a")
+        out[f"bestfalsealarms:{s}"] = (out[f"falsealarms:{best['method'].iloc[0]}:{s}"]
+                                       if len(best) else "n/a")
         tied = table[(table["vs_best_p"] >= 0.05) & (table["block"] == "honest")]
         out[f"tied:{s}"] = ", ".join(tied["method"]) or "none"
     for (m, s), table in sweep.groupby(["method", "subset"], sort=False):
         clean = table[table["fp"] == 0]
         out[f"recallnofa:{m}:{s}"] = _pct(clean["recall"].max()) if len(clean) else "n/a"
-    # every signal and fault class, so that a flight set without some class still renders
-    out |= {f"{k}:{sig}:{c}": "n/a" for k in ("leak", "leakchance") for sig in SIGNALS
-            for c in FAULT_ORDER if c != "none"}
-    for r in leakage.to_dict(orient="records"):
-        key = f"{r['signal']}:{r['fault_class']}"
-        out[f"leak:{key}"] = f"{r['flat_at_onset']} of {r['flights']}"
-        out[f"leakchance:{key}"] = _pct(float(np.nanmax([r["chance_before_onset"],
-                                                          r["chance_fault_free"]])))
-    out |= {f"classdetected:{m}:{s}:{c}": "n/a" for m, s in
-            comparison[["method", "subset"]].itertuples(index=False)
+    out |= _leak_numbers(leakage)
+    runs = [*dict.fromkeys([*methods, *comparison["method"]])]
+    # every run, subset and class first, so that a flight set without some still renders
+    out |= {f"classdetected:{m}:{s}:{c}": "n/a" for m in runs
+            for s in [*dict.fromkeys([*subsets, *comparison["subset"]])]
             for c in FAULT_ORDER if c != "none"}
     for r in ([] if by_fault is None else by_fault.to_dict(orient="records")):
         if r["fault_class"] not in ("none", "total"):
             out[f"classdetected:{r['method']}:{r['subset']}:{r['fault_class']}"] = (
                 f"{r['detected']} of {r['flights']}")
-    runs = [*dict.fromkeys([*methods, *comparison["method"]])]
-    out |= {f"classdetected:{m}:{s}:{c}": "n/a" for m in runs for s in subsets
-            for c in FAULT_ORDER if c != "none"}
     out |= {f"{k}:{m}:{c}": "n/a" for k in ("marginmax", "marginmin") for m in runs
             for c in FAULT_ORDER if c != "none"}
     out |= {f"marginbefore:{m}": "n/a" for m in runs}
@@ -138,6 +142,25 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.Dat
             if rows["margin_before"].notna().any():
                 out[f"marginbefore:{m}"] = f"{rows['margin_before'].max():.2f}"
     return out | sensor_numbers(sensors or {}, runs)
+
+
+def _leak_numbers(leakage: pd.DataFrame) -> dict[str, str]:
+    """``leak``/``leakchance`` (the flat test over a class's flights) and ``step``
+    (the step test on the class's flights with and without an emergency trajectory),
+    for every signal and class: "n/a" where the flights have none."""
+    classes = [c for c in FAULT_ORDER if c != "none"]
+    out = {f"{k}:{sig}:{c}": "n/a" for k in ("leak", "leakchance") for sig in SIGNALS
+           for c in classes}
+    out |= {f"step:{sig}:{c}:{e}": "n/a" for sig in SIGNALS for c in classes
+            for e in ("emr", "noemr")}
+    for (sig, c), g in leakage.groupby(["signal", "fault_class"], sort=False):
+        out[f"leak:{sig}:{c}"] = f"{int(g['flat_at_onset'].sum())} of {int(g['flights'].sum())}"
+        out[f"leakchance:{sig}:{c}"] = _pct(float(np.nanmax(
+            [*g["flat_chance_before"], *g["flat_chance_fault_free"], 0.0])))
+        for r in g.to_dict(orient="records"):
+            e = "emr" if r["emergency_trajectory"] else "noemr"
+            out[f"step:{sig}:{c}:{e}"] = f"{r['step_at_onset']} of {r['step_flights']}"
+    return out
 
 
 def sensor_numbers(tables: dict, runs) -> dict[str, str]:

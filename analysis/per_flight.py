@@ -8,6 +8,13 @@ onset, and the channel that raised it (the earliest of the record's
 ``alarm 10.4 s before onset (thrust)``, ``first alarm 12.6 s after onset, past the
 deadline (pitch)``, ``no alarm``, ``false alarm at 72.0 s (thrust)``.
 
+A detection in time is flagged when its first channel cannot see the fault's class:
+``detected_class`` is the class acting on the axis its first alarm isolates
+(:func:`~.isolation.named_class`; an aileron flight alarmed first by ``thrust`` names
+``engine``; empty where no class is named), and ``other_class`` is true where it is
+another than the flight's class, so the
+verdict adds ``first on the engine axis, not aileron``. Nothing is removed.
+
 Margins, from the stored traces, in units of the threshold (a channel alarms above 1):
 ``margin_in_time`` is the largest score/threshold of any channel from the onset to the
 deadline, with its ``margin_channel``: how near the fault came to being detected in
@@ -28,15 +35,18 @@ import pandas as pd
 from alfa_bench.data import subset_flights
 from alfa_bench.methods import Trace
 
+from .isolation import named_class, names_class
+from .render import fmt, markdown
 from .scoring import flight_outcome
-from .tables import BLOCK_MARKS, BLOCKS, block, fmt, markdown
+from .tables import BLOCK_MARKS, BLOCKS, block
 
 __all__ = ["margins", "per_flight_markdown", "per_flight_table", "verdict"]
 
 
 def verdict(onset_s: float | None, first_alarm_s: float | None, channel: str | None,
-            deadline_s: float) -> str:
-    """The outcome of one flight in words (module docstring)."""
+            deadline_s: float, other_axis: tuple[str, str] | None = None) -> str:
+    """The outcome of one flight in words (module docstring); ``other_axis`` is
+    ``(named class, true class)`` for a detection first on another class's axis."""
     by = f" ({channel})" if channel else ""
     if first_alarm_s is None:
         return "no alarm"
@@ -47,7 +57,8 @@ def verdict(onset_s: float | None, first_alarm_s: float | None, channel: str | N
         return f"alarm {-delay:.1f} s before onset{by}"
     if delay > deadline_s:
         return f"first alarm {delay:.1f} s after onset, past the deadline{by}"
-    return f"detected in {delay:.2f} s{by}"
+    flag = f", first on the {other_axis[0]} axis, not {other_axis[1]}" if other_axis else ""
+    return f"detected in {delay:.2f} s{by}{flag}"
 
 
 def _first_channel(record: dict) -> str | None:
@@ -90,6 +101,9 @@ def per_flight_table(records: list[dict], traces: Mapping[tuple[str, str], Trace
             continue
         onset, first = r["onset_s"], r["first_alarm_s"]
         channel = _first_channel(r)
+        outcome = flight_outcome(onset, first, deadline_s)
+        detected = named_class(r) if outcome == "TP" else None
+        other = detected is not None and not names_class(r)
         in_time, margin_channel, before = margins(traces[r["method"], r["flight"]], onset,
                                                   deadline_s)
         rows.append({
@@ -97,9 +111,10 @@ def per_flight_table(records: list[dict], traces: Mapping[tuple[str, str], Trace
             "fault_class": r["fault_class"], "emergency_trajectory": bool(emr[r["flight"]]),
             "onset_s": onset, "first_alarm_s": first,
             "delay_s": first - onset if onset is not None and first is not None else math.nan,
-            "first_channel": channel,
-            "outcome": flight_outcome(onset, first, deadline_s),
-            "verdict": verdict(onset, first, channel, deadline_s),
+            "first_channel": channel, "outcome": outcome,
+            "detected_class": detected or "", "other_class": other,
+            "verdict": verdict(onset, first, channel, deadline_s,
+                               (detected, r["fault_class"]) if other else None),
             "margin_in_time": in_time, "margin_channel": margin_channel,
             "margin_before": before})
     table = pd.DataFrame(rows)

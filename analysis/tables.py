@@ -33,13 +33,15 @@ import pandas as pd
 
 from alfa_bench.data import FAILURE_COLUMNS, subset_flights
 
+from .isolation import names_class
 from .reference import ICRA2019_BY_FAULT, ICRA2019_NAME, ICRA2019_SUMMARY
+from .render import Section, fmt, latex_tables, markdown
 from .scoring import mcnemar_exact, score_records
 
-__all__ = ["BLOCKS", "BLOCK_MARKS", "FAULT_ORDER", "Section", "block", "by_fault_latex",
+__all__ = ["BLOCKS", "BLOCK_MARKS", "FAULT_ORDER", "block", "by_fault_latex",
            "by_fault_markdown", "by_fault_table", "comparison_latex", "comparison_markdown",
-           "comparison_notes", "comparison_table", "failures_table", "fmt", "latex_escape",
-           "markdown", "summary_latex", "summary_markdown", "summary_table", "unscored_notes"]
+           "comparison_notes", "comparison_table", "failures_table", "summary_latex",
+           "summary_markdown", "summary_table", "unscored_notes"]
 
 FAULT_ORDER = ("engine", "rudder", "elevator", "aileron", "rudder+aileron", "none")
 
@@ -122,8 +124,19 @@ def summary_table(records: list[dict], manifest: pd.DataFrame, subsets, deadline
 
 
 def _calibration(rec: dict) -> str:
+    """What a run learned from, and how the scored group was kept out of it."""
     cal = rec.get("calibration")
-    return f"leave-one-{cal['group_by']}-out" if cal else "none"
+    if not cal:
+        return "none"
+    data = "supervised (labelled flights)" if cal.get("supervised") else "fault-free only"
+    return f"{data}, leave-one-{cal['group_by']}-out"
+
+
+def _isolation(recs: list[dict], outcomes: list[str]) -> tuple[int, int]:
+    """Of the in-time detections, how many alarmed first on a channel that names the
+    flight's fault class, and how many there are (:func:`~.isolation.names_class`)."""
+    hits = [r for r, o in zip(recs, outcomes, strict=True) if o == "TP"]
+    return sum(names_class(r) for r in hits), len(hits)
 
 
 def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadline_s: float,
@@ -138,6 +151,7 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
         for method, (recs, excluded) in _records_for(records, manifest, subset,
                                                      failures).items():
             outcomes, s = _scores(recs, deadline_s)
+            named, hits = _isolation(recs, outcomes)
             free = [r for r in recs if r["fault_class"] == "none"]
             correct = {r["flight"]: o in ("TP", "TN")
                        for r, o in zip(recs, outcomes, strict=True)}
@@ -149,6 +163,7 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
                 "fault_free_false_alarms": sum(r["first_alarm_s"] is not None for r in free),
                 "armed_flights": sum(any(v is not None for v in r["pair_armed_s"].values())
                                      for r in recs),
+                "isolation": named / hits if hits else math.nan,
                 "excluded": len(excluded),
             }))
         honest = sorted((r for r in runs if r[1]["block"] == "honest"),
@@ -185,7 +200,8 @@ def by_fault_table(records: list[dict], manifest: pd.DataFrame, subsets, deadlin
             for fault_class, group in groups.items():
                 if not group:
                     continue
-                _, s = _scores(group, deadline_s)
+                outcomes, s = _scores(group, deadline_s)
+                named, hits = _isolation(group, outcomes)
                 flights = [r["flight"] for r in group]
                 rows.append({
                     "method": method, "subset": subset, "block": block(group[0]),
@@ -194,64 +210,13 @@ def by_fault_table(records: list[dict], manifest: pd.DataFrame, subsets, deadlin
                     "flight_time_s": float(info.loc[flights, "flight_s"].sum()),
                     "pre_fault_s": float(info.loc[flights, "pre_fault_s"].sum()),
                     "detected": s["tp"], "detected_paper": s["tp_paper"],
+                    # in time, but first on a channel of another axis than the fault's
+                    "detected_other_class": hits - named,
                     "mean_detection_s": s["mean_detection_s"],
                     "max_detection_s": s["max_detection_s"],
                     "accuracy": s["accuracy"], "accuracy_paper": s["accuracy_paper"],
                 })
     return pd.DataFrame(rows)
-
-
-def fmt(v, pct=False, digits=2) -> str:
-    """A table cell: ``-`` for a missing value, a fraction as a percentage with ``pct``."""
-    if v is None or (isinstance(v, float) and math.isnan(v)):
-        return "-"
-    if isinstance(v, float):
-        return f"{100 * v:.{digits}f}" if pct else f"{v:.{digits}f}"
-    return str(v)
-
-
-Section = tuple[str, list[str], list[list[str]]]  # title (`code` marked), header, rows
-
-
-def markdown(sections: list[Section]) -> str:
-    """Markdown tables, one per section, each under its title."""
-    out = []
-    for title, header, rows in sections:
-        lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-        lines += ["| " + " | ".join(r) + " |" for r in rows]
-        out.append(f"### {title}\n\n" + "\n".join(lines) + "\n")
-    return "\n".join(out)
-
-
-_LATEX_ESCAPES = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$",
-                  "#": r"\#", "_": r"\_", "{": r"\{", "}": r"\}", "~": r"\textasciitilde{}",
-                  "^": r"\textasciicircum{}"}
-
-
-def latex_escape(text: str) -> str:
-    """Escape ``text`` for LaTeX; `code` becomes \\texttt{code}."""
-    parts = text.split("`")
-    esc = ["".join(_LATEX_ESCAPES.get(ch, ch) for ch in part) for part in parts]
-    return "".join(rf"\texttt{{{e}}}" if i % 2 else e for i, e in enumerate(esc))
-
-
-_SHRINK = r"\resizebox{\ifdim\width>\linewidth\linewidth\else\width\fi}{!}{%"
-
-
-def _latex(sections: list[Section], label: str) -> str:
-    """One booktabs table float per section, labelled ``tab:<label>-<1, 2, ...>``, shrunk
-    to the line width where wider (needs the graphicx and booktabs packages)."""
-    out = []
-    for i, (title, header, rows) in enumerate(sections, 1):
-        spec = "l" * 3 + "r" * (len(header) - 3) if len(header) > 3 else "l" * len(header)
-        lines = [r"\begin{table}[htbp]", r"\centering", r"\scriptsize",
-                 rf"\caption{{{latex_escape(title)}}}\label{{tab:{label}-{i}}}", _SHRINK,
-                 rf"\begin{{tabular}}{{{spec}}}", r"\toprule",
-                 " & ".join(latex_escape(h) for h in header) + r" \\", r"\midrule"]
-        lines += [" & ".join(latex_escape(c) for c in r) + r" \\" for r in rows]
-        lines += [r"\bottomrule", r"\end{tabular}}", r"\end{table}"]
-        out.append("\n".join(lines) + "\n")
-    return "\n".join(out)
 
 
 def _rate(r, key: str) -> str:
@@ -317,8 +282,8 @@ def _by_fault_sections(by_fault: pd.DataFrame) -> list[Section]:
         paper = subset == "icra22"
         d = _deadline(table)
         header = ["fault", "flights", "flight time s", "pre-fault s", f"detected ≤{d} s",
-                  "mean det. s", "max det. s", f"accuracy % ≤{d} s", "detected (paper's rule)",
-                  "accuracy % (paper's rule)"]
+                  "of them first on another axis", "mean det. s", "max det. s",
+                  f"accuracy % ≤{d} s", "detected (paper's rule)", "accuracy % (paper's rule)"]
         if paper:
             header += ["paper: flights", "paper: flight time s", "paper: mean det. s",
                        "paper: max det. s", "paper: accuracy %"]
@@ -326,7 +291,8 @@ def _by_fault_sections(by_fault: pd.DataFrame) -> list[Section]:
         for r in table.to_dict(orient="records"):
             row = [r["fault_class"], str(r["flights"]), fmt(r["flight_time_s"], digits=1),
                    fmt(r["pre_fault_s"], digits=1), str(r["detected"]),
-                   fmt(r["mean_detection_s"]), fmt(r["max_detection_s"]),
+                   str(r["detected_other_class"]), fmt(r["mean_detection_s"]),
+                   fmt(r["max_detection_s"]),
                    fmt(r["accuracy"], True), str(r["detected_paper"]),
                    fmt(r["accuracy_paper"], True)]
             if paper:
@@ -339,7 +305,17 @@ def _by_fault_sections(by_fault: pd.DataFrame) -> list[Section]:
     return out
 
 
-def _comparison_sections(comparison: pd.DataFrame) -> list[Section]:
+#: what each subset holds, as the comparison titles it
+SUBSET_NOTES = {
+    "no_emr": "no emergency trajectory",
+    "all": "includes the emergency-trajectory flights, whose commands switch at onset",
+    "icra22": "the flights of Keipour et al., ICRA 2019",
+    "emr": "emergency trajectory only: the commands switch at onset",
+}
+
+
+def _comparison_sections(comparison: pd.DataFrame, primary: str | None = None
+                         ) -> list[Section]:
     out = []
     for subset, table in comparison.groupby("subset", sort=False):
         d = _deadline(table)
@@ -347,6 +323,7 @@ def _comparison_sections(comparison: pd.DataFrame) -> list[Section]:
                   f"recall % ≤{d} s [95 % CI]", f"accuracy % ≤{d} s [95 % CI]",
                   "mean det. s", "max det. s", "accuracy % (paper's rule)",
                   "mean det. s (paper's rule)", "false alarms, fault-free flights",
+                  "in-time detections first on the fault's axis %",
                   "vs best honest: only this / only best correct, McNemar p",
                   "flights armed", "flights excluded"]
 
@@ -361,7 +338,8 @@ def _comparison_sections(comparison: pd.DataFrame) -> list[Section]:
                     _rate(r, "precision"), _rate(r, "recall"), _rate(r, "accuracy"),
                     fmt(r.get("mean_detection_s")), fmt(r.get("max_detection_s")),
                     fmt(r["accuracy_paper"], True), fmt(r["mean_detection_s_paper"]),
-                    f"{r['fault_free_false_alarms']} of {r['fault_free_flights']}", paired,
+                    f"{r['fault_free_false_alarms']} of {r['fault_free_flights']}",
+                    fmt(r.get("isolation"), True, 0), paired,
                     fmt(r.get("armed_flights")), fmt(r.get("excluded"))]
 
         records = table.to_dict(orient="records")
@@ -378,7 +356,9 @@ def _comparison_sections(comparison: pd.DataFrame) -> list[Section]:
         # the subset's size: the first method's scored and excluded flights
         first = table.iloc[0]
         flights = int(first["flights"]) + int(first.get("excluded", 0))
-        out.append((f"Subset `{subset}` ({flights} flights; deadline {d} s)", header,
+        head = "Headline: subset" if subset == primary else "Subset"
+        note = f"; {SUBSET_NOTES[subset]}" if subset in SUBSET_NOTES else ""
+        out.append((f"{head} `{subset}` ({flights} flights{note}; deadline {d} s)", header,
                     rows))
     return out
 
@@ -407,7 +387,7 @@ def summary_markdown(summary: pd.DataFrame) -> str:
 
 def summary_latex(summary: pd.DataFrame) -> str:
     """:func:`summary_markdown` as LaTeX (booktabs)."""
-    return _latex(_summary_sections(summary), "summary")
+    return latex_tables(_summary_sections(summary), "summary")
 
 
 def by_fault_markdown(by_fault: pd.DataFrame) -> str:
@@ -417,7 +397,7 @@ def by_fault_markdown(by_fault: pd.DataFrame) -> str:
 
 def by_fault_latex(by_fault: pd.DataFrame) -> str:
     """:func:`by_fault_markdown` as LaTeX (booktabs)."""
-    return _latex(_by_fault_sections(by_fault), "by-fault")
+    return latex_tables(_by_fault_sections(by_fault), "by-fault")
 
 
 def unscored_notes(comparison: pd.DataFrame, failures: pd.DataFrame, manifest: pd.DataFrame,
@@ -442,14 +422,17 @@ def unscored_notes(comparison: pd.DataFrame, failures: pd.DataFrame, manifest: p
     return "\n### Runs not scored\n\n" + "\n".join(lines) + "\n" if lines else ""
 
 
-def comparison_markdown(comparison: pd.DataFrame, unscored: str = "") -> str:
-    """One table per subset, in blocks; the ICRA 2019 paper's row under ``icra22``; which
-    differences the data cannot tell apart; then ``unscored`` (:func:`unscored_notes`)."""
-    return (markdown(_comparison_sections(comparison))
+def comparison_markdown(comparison: pd.DataFrame, unscored: str = "", primary: str | None = None,
+                        audit: str = "") -> str:
+    """``audit`` (what the leakage audit finds on the ``primary`` subset), then one table
+    per subset, in blocks, the ``primary`` one titled the headline; the ICRA 2019 paper's
+    row under ``icra22``; which differences the data cannot tell apart; then
+    ``unscored`` (:func:`unscored_notes`)."""
+    return (audit + markdown(_comparison_sections(comparison, primary))
             + "\n### Which differences the data can tell\n\n" + comparison_notes(comparison)
             + unscored)
 
 
 def comparison_latex(comparison: pd.DataFrame) -> str:
     """:func:`comparison_markdown` as LaTeX (booktabs)."""
-    return _latex(_comparison_sections(comparison), "comparison")
+    return latex_tables(_comparison_sections(comparison), "comparison")

@@ -12,6 +12,12 @@ METHODS = list(config["methods"])
 DETECTORS = [m for m, spec in config["methods"].items()
              if spec.get("role", "method") != "reference"]
 REFERENCES = [m for m in METHODS if m not in DETECTORS]
+PRIMARY = config["primary_subset"]
+if PRIMARY not in config["subsets"]:
+    raise WorkflowError(f"config primary_subset {PRIMARY!r} is not one of subsets "
+                        f"{config['subsets']}")
+# the tables list the subsets in this order: the headline first
+SUBSETS = [PRIMARY, *(s for s in config["subsets"] if s != PRIMARY)]
 # where `snakemake injected_csv` writes the injected flights, and so their folder name
 INJECTED_PROCESSED = "results/injected/processed"
 

@@ -10,9 +10,9 @@ rule sweep:
         figure=report("results/figures/sweep.png", caption="../report/sweep.rst",
                       category="Threshold sweeps"),
     params:
-        subsets=config["subsets"],
+        subsets=SUBSETS,
         deadline_s=config["scoring"]["deadline_s"],
-        subset=config["figures"]["subset"],
+        subset=PRIMARY,
     log:
         "results/logs/sweep.log",
     script:

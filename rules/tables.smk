@@ -3,6 +3,7 @@ rule tables:
         manifest="data/flights.csv",
         load_failures="data/load_failures.csv",
         detections=expand("results/detections/{method}", method=METHODS),
+        leakage="results/tables/leakage.csv",
     output:
         failures=report("results/tables/failures.csv", category="Tables"),
         summary="results/tables/summary.csv",
@@ -15,7 +16,8 @@ rule tables:
         by_fault_tex="results/tables/by_fault.tex",
         comparison_tex="results/tables/comparison.tex",
     params:
-        subsets=config["subsets"],
+        subsets=SUBSETS,
+        primary=PRIMARY,
         deadline_s=config["scoring"]["deadline_s"],
     log:
         "results/logs/tables.log",
@@ -67,9 +69,9 @@ rule deadline:
                               caption="../report/detection_time.rst",
                               category="Detection times"),
     params:
-        subsets=config["subsets"],
+        subsets=SUBSETS,
         deadlines_s=config["scoring"]["deadlines_s"],
-        subset=config["figures"]["subset"],
+        subset=PRIMARY,
     log:
         "results/logs/deadline.log",
     script:

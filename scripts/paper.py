@@ -12,7 +12,7 @@ log_to(sm.log[0])
 numbers = paper_numbers(read_table(sm.input.comparison), read_table(sm.input.sweep),
                         read_table(sm.input.leakage), read_table(sm.input.by_fault),
                         read_table(sm.input.per_flight), methods=list(sm.config["methods"]),
-                        subsets=sm.config["subsets"],
+                        subsets=sm.config["subsets"], primary=sm.config["primary_subset"],
                         sensors={k: read_table(sm.input[k]) for k in (
                             "detectability", "isolation_sensors", "isolation_actuators")})
 unknown = latex_keys(Path(sm.input.tex).read_text()) - set(numbers)

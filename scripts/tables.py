@@ -1,5 +1,6 @@
 """Snakemake script: summary, per-fault and comparison tables (CSV, Markdown, LaTeX)."""
 
+import logging
 from pathlib import Path
 
 import pandas as pd
@@ -18,8 +19,9 @@ from alfa_bench.analysis import (
     summary_markdown,
     summary_table,
 )
+from alfa_bench.analysis.leakage import audit_note
 from alfa_bench.analysis.logs import log_to
-from alfa_bench.analysis.provenance import run_provenance, stamp
+from alfa_bench.analysis.provenance import read_table, run_provenance, stamp
 from alfa_bench.analysis.tables import unscored_notes
 from alfa_bench.data import read_manifest
 
@@ -39,8 +41,12 @@ by_fault.to_csv(sm.output.by_fault, index=False)
 comparison.to_csv(sm.output.comparison, index=False)
 Path(sm.output.summary_md).write_text(summary_markdown(summary))
 Path(sm.output.by_fault_md).write_text(by_fault_markdown(by_fault))
+audit = audit_note(read_table(sm.input.leakage), manifest, sm.params.primary)
+if audit.startswith("**WARNING"):
+    logging.getLogger("alfa_bench.analysis").warning(audit.replace("*", "").strip())
 Path(sm.output.comparison_md).write_text(comparison_markdown(
-    comparison, unscored_notes(comparison, failures, manifest, sm.params.subsets)))
+    comparison, unscored_notes(comparison, failures, manifest, sm.params.subsets),
+    sm.params.primary, audit))
 Path(sm.output.summary_tex).write_text(summary_latex(summary))
 Path(sm.output.by_fault_tex).write_text(by_fault_latex(by_fault))
 Path(sm.output.comparison_tex).write_text(comparison_latex(comparison))

@@ -130,11 +130,13 @@ def write_csv(path: Path, header: str, rows: list[str]) -> None:
 def write_flight(processed: Path, name: str, *, duration_s: float = 80.0, rate_hz: float = 20.0,
                  onset_s: float | None = None, fault_topic: str = "failure_status-engines",
                  code: int = 1, gt_rate_hz: float = 2.0, seed: int = 0,
-                 emulate_surfaces: bool = False) -> Path:
+                 emulate_surfaces: bool = False, switch_deg: float = 0.0) -> Path:
     """Write flight ``name`` under ``processed`` and return its folder.
 
     ``onset_s`` None writes a fault-free flight (no failure_status file). With
     ``emulate_surfaces`` the failed surface's servo channel goes flat at onset too.
+    ``switch_deg`` is added to the roll and pitch commands from onset on, as ALFA's
+    emergency trajectory switches them.
     """
     rng = np.random.default_rng(seed)
     folder = processed / name
@@ -143,7 +145,7 @@ def write_flight(processed: Path, name: str, *, duration_s: float = 80.0, rate_h
     t_ns = T0_NS + np.round(np.arange(n) / rate_hz * 1e9).astype(np.int64) + 1_000_000
     faulty = np.zeros(n, dtype=bool) if onset_s is None else np.arange(n) / rate_hz >= onset_s
     for i, axis in enumerate(("roll", "pitch")):
-        u = command(n, rate_hz, rng) / (i + 1)
+        u = command(n, rate_hz, rng) / (i + 1) + switch_deg * faulty
         y = arx_response(u, 0.8, 0.2, rng.normal(0, 0.05, n))
         y_fault = arx_response(u, 0.8, 0.0, rng.normal(0, 0.05, n)) + 8.0
         measured = np.where(faulty, y_fault, y)

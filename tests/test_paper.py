@@ -30,10 +30,13 @@ def comparison(**overrides):
 
 
 def leakage():
-    return pd.DataFrame({"signal": ["servo_throttle", "roll"], "fault_class": ["engine"] * 2,
-                         "flights": [20, 20], "flat_at_onset": [20, 0],
-                         "chance_before_onset": [0.1, float("nan")],
-                         "chance_fault_free": [0.15, 0.0]})
+    return pd.DataFrame({"signal": ["servo_throttle", "roll", "roll_cmd", "roll_cmd"],
+                         "fault_class": ["engine"] * 4,
+                         "emergency_trajectory": [False, False, False, True],
+                         "flights": [20, 20, 7, 13], "flat_at_onset": [20, 0, 0, 0],
+                         "flat_chance_before": [0.1, float("nan"), 0.0, 0.0],
+                         "flat_chance_fault_free": [0.15, 0.0, 0.0, 0.0],
+                         "step_at_onset": [20, 1, 1, 5], "step_flights": [20, 20, 7, 13]})
 
 
 def sweep():
@@ -52,6 +55,9 @@ def test_numbers_come_from_the_tables():
     assert n["leakchance:servo_throttle:engine"] == "15.00"
     assert n["leakchance:roll:engine"] == "0.00"
     assert n["leak:servo_elevator:elevator"] == "n/a"    # no elevator flight here
+    assert n["leak:roll_cmd:engine"] == "0 of 20"        # both groups together
+    assert (n["step:roll_cmd:engine:emr"], n["step:roll_cmd:engine:noemr"]) == ("5 of 13",
+                                                                                 "1 of 7")
     assert n["falsealarms:a:all"] == "1 of 3"
     assert n["recallnofa:a:all"] == "10.00" and n["recallnofa:b:all"] == "n/a"
     assert n["paper:accuracy"] == "86.36"
@@ -63,6 +69,11 @@ def test_per_class_numbers_come_from_the_by_fault_table():
                              "flights": [4, 2, 6], "detected": [3, 0, 3]})
     n = paper_numbers(comparison(), sweep(), leakage(), by_fault)
     assert n["classdetected:a:all:engine"] == "3 of 4"
+    # the configured runs and subsets, as the workflow passes them, keep the numbers
+    n = paper_numbers(comparison(), sweep(), leakage(), by_fault, methods=["a", "z"],
+                      subsets=["all", "no_emr"])
+    assert n["classdetected:a:all:engine"] == "3 of 4"
+    assert n["classdetected:z:no_emr:engine"] == "n/a"
     assert n["classdetected:a:all:aileron"] == "n/a"     # no aileron flight here
     assert "classdetected:a:all:none" not in n and "classdetected:a:all:total" not in n
 
@@ -125,10 +136,11 @@ def test_latex_tables_escape_and_label():
     tex = comparison_latex(comparison())
     assert r"\label{tab:comparison-1}" in tex and r"\texttt{all}" in tex
     assert "\\toprule" in tex and tex.count(r"\begin{table}") == 1
-    assert (" & 50.0 & 25.0 & 40.0 & 1.50 & - & 70.00 & 6.00 & 1 of 3 & 0 / 2, p = 0.500 "
+    assert (" & 50.0 & 25.0 & 40.0 & 1.50 & - & 70.00 & 6.00 & 1 of 3 & - & 0 / 2, p = 0.500 "
             "(cannot tell apart) & 10 & 1 \\\\") in tex
     assert "MARKED: reads what the fault emulation writes" in tex
-    assert "(11 flights; deadline 5.0 s)" in tex
+    assert ("(11 flights; includes the emergency-trajectory flights, whose commands switch "
+            "at onset; deadline 5.0 s)") in tex
 
 
 def test_sensor_fault_numbers_come_from_the_grid_and_the_isolation_tables():

@@ -48,3 +48,21 @@ def test_table_rows_follow_the_records():
     assert table.loc[0, "verdict"] == "detected in 1.00 s (a)"
     assert table.loc[0, "margin_in_time"] == 1.5 and table.loc[1, "margin_before"] == 1.5
     assert table["emergency_trajectory"].tolist() == [False, True]
+    assert table["other_class"].tolist() == [False, False]
+
+
+def test_a_detection_first_on_another_axis_is_flagged_not_removed():
+    manifest = pd.DataFrame({"flight": ["f1", "f2"], "emergency_trajectory": [True, False],
+                             "subsets": ["all", "all"], "ground_truth": [True, True]})
+    base = {"method": "m", "role": "method", "reads_actuators": False, "onset_s": 2.0,
+            "first_alarm_s": 3.0, "pair_first_alarm_s": {"a": 3.0, "b": None}}
+    records = [{**base, "flight": "f1", "fault_class": "aileron", "isolated_sensor": "accel_x"},
+               {**base, "flight": "f2", "fault_class": "rudder+aileron",
+                "isolated_sensor": "roll_rate"}]
+    tr = trace([[1.0, 1.0], [1.0, 1.0], [1.0, 1.0], [3.0, 1.0], [1.0, 1.0]])
+    table = per_flight_table(records, {("m", "f1"): tr, ("m", "f2"): tr}, manifest, 5.0)
+    assert table["outcome"].tolist() == ["TP", "TP"]
+    assert table["detected_class"].tolist() == ["engine", "aileron"]
+    assert table["other_class"].tolist() == [True, False]
+    assert table.loc[0, "verdict"] == ("detected in 1.00 s (a), first on the engine axis, "
+                                       "not aileron")

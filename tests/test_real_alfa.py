@@ -1,14 +1,18 @@
 """Checks on the real ALFA flights (skipped, and said so in the header, without ALFA_DIR)."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
+import yaml
 
 from alfa_bench.analysis import detection_record
 from alfa_bench.data import build_manifest, load_flight, subset_flights
 from alfa_bench.methods import REGISTRY, fault_free_segments, make_detector, run_detector
+
+CONFIG = yaml.safe_load((Path(__file__).parents[1] / "config/config.yaml").read_text())
 
 
 @pytest.fixture(scope="module")
@@ -65,22 +69,43 @@ def test_calibrated_detectors_fit_and_run_on_real_flights(name, manifest, real_p
     json.dumps(det.fitted(), allow_nan=False)             # finite, JSON-ready
 
 
-def test_the_leakage_audit_finds_the_emulation_and_no_sensor(manifest, real_processed):
-    """On ALFA itself: the failed actuator's output goes flat at onset, measured, on its
-    own fault class; no attitude, gyro or setpoint signal does."""
+@pytest.fixture(scope="module")
+def leakage(manifest, real_processed):
     from alfa_bench.analysis.leakage import leakage_table
-    flights = {n: load_flight(real_processed / n)
-               for n in manifest.loc[manifest["ground_truth"], "flight"]}
-    table = leakage_table(flights)
-    leaks = set(map(tuple, table.loc[table["leaks"], ["signal", "fault_class"]].to_numpy()))
+    return leakage_table({n: load_flight(real_processed / n)
+                          for n in manifest.loc[manifest["ground_truth"], "flight"]})
+
+
+def test_the_leakage_audit_finds_the_emulation_and_no_sensor(leakage):
+    """On ALFA itself: the failed actuator's output goes flat at onset, measured, on its
+    own fault class; no attitude, gyro or setpoint signal does, and no sensor leaks."""
+    table = leakage
+    flat = set(map(tuple, table.loc[table["goes_flat"], ["signal", "fault_class"]].to_numpy()))
     expected = {("servo_throttle", "engine"), ("throttle", "engine")}
     classes = set(table["fault_class"])
     expected |= {("servo_rudder", "rudder")} if "rudder" in classes else set()
     expected |= {("servo_elevator", "elevator")} if "elevator" in classes else set()
-    assert expected <= leaks
-    assert not set(table.loc[table["leaks"], "kind"]) - {"actuator"}
-    for sensor in ("roll", "pitch", "roll_rate", "pitch_rate", "yaw_rate"):
+    assert expected <= flat
+    assert not set(table.loc[table["goes_flat"], "kind"]) - {"actuator"}
+    for sensor in ("roll", "pitch", "roll_rate", "pitch_rate", "yaw_rate", "accel_x"):
         assert not table.loc[table["signal"] == sensor, "leaks"].any(), sensor
+
+
+def test_the_emergency_trajectory_switches_the_commands_and_only_there(leakage):
+    """The commanded attitude steps at onset on the emr engine flights, and no
+    setpoint leaks on a flight without an emergency trajectory."""
+    rows = leakage.set_index(["signal", "fault_class", "emergency_trajectory"])
+    for signal in ("roll_cmd", "pitch_cmd", "roll_error", "pitch_error"):
+        assert rows.loc[(signal, "engine", True), "leaks"], signal
+    setpoints = leakage[leakage["kind"] == "setpoint"]
+    assert not setpoints.loc[~setpoints["emergency_trajectory"], "leaks"].any()
+
+
+def test_the_headline_subset_holds_no_flight_an_honest_signal_leaks_on(leakage, manifest):
+    from alfa_bench.analysis.leakage import leaking_flights
+    primary = CONFIG["primary_subset"]
+    assert leaking_flights(leakage, manifest, subset_flights(manifest, primary)) == {}
+    assert leaking_flights(leakage, manifest, subset_flights(manifest, "all"))
 
 
 def test_measured_airspeed_is_not_measured_from_2018_09_11_on(manifest):

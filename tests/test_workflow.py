@@ -195,7 +195,12 @@ def test_the_honest_benchmark_outputs(runs):
     assert {("servo_throttle", "engine"), ("throttle", "engine"),
             ("servo_rudder", "rudder")} <= leaking
     assert not set(leak.loc[leak["leaks"], "kind"]) - {"actuator"}
-    assert "Which signals carry the fault emulation" in (out / "tables/leakage.md").read_text()
+    assert "Which signals carry the label" in (out / "tables/leakage.md").read_text()
+    # the headline first, under the audit's verdict on it
+    comparison = (out / "tables/comparison.md").read_text()
+    assert comparison.startswith("The headline subset `no_emr`")
+    assert "finds no sensor or setpoint carrying the label" in comparison.splitlines()[0]
+    assert "### Headline: subset `no_emr`" in comparison
     deadline = read_table(out / "tables/deadline.csv")
     for _, g in deadline.groupby(["method", "subset"]):
         assert g.sort_values("deadline_s")["detected"].is_monotonic_increasing
