@@ -144,7 +144,12 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
     """Per subset and method, in block order (honest ones ranked): the scores under the
     deadline and by the paper's rule, false alarms on fault-free flights, the
     calibration protocol, the flights excluded, and the exact McNemar test against the
-    best honest method on the flights both scored."""
+    best honest method on the flights both scored.
+
+    Ranks compare like with like: an honest run is ranked only if it scored every
+    flight that any honest run scored of the subset, and armed on at least one;
+    otherwise ``not_ranked`` says why (``scored on k of n``, ``never armed``) and it
+    follows the ranked ones, without a rank."""
     rows = []
     for subset in subsets:
         runs = []
@@ -169,9 +174,18 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
         honest = sorted((r for r in runs if r[1]["block"] == "honest"),
                         key=lambda r: (-_num(r[1]["accuracy"]), -_num(r[1]["recall"]),
                                        _num(r[1]["mean_detection_s"], math.inf)))
-        for i, (_, row) in enumerate(honest, 1):
+        common = set().union(*(set(c) for c, _ in honest))
+        for correct, row in runs:
+            row["not_ranked"] = ("" if row["block"] != "honest" else
+                                 f"scored on {len(correct)} of {len(common)}"
+                                 if set(correct) != common else
+                                 "never armed" if row["armed_flights"] == 0 else "")
+        ranked = [r for r in honest if not r[1]["not_ranked"]]
+        for i, (_, row) in enumerate(ranked, 1):
             row["rank"] = i
-        ordered = honest + [r for b in BLOCKS[1:] for r in runs if r[1]["block"] == b]
+        ordered = ranked + [r for r in honest if r[1]["not_ranked"]] + [
+            r for b in BLOCKS[1:] for r in runs if r[1]["block"] == b]
+        honest = ranked
         best_correct, best = honest[0] if honest else ({}, None)
         for correct, row in ordered:
             row["best_honest"] = best["method"] if best else ""
@@ -333,7 +347,10 @@ def _comparison_sections(comparison: pd.DataFrame, primary: str | None = None
                       f"{int(r['vs_best_only_this'])} / {int(r['vs_best_only_best'])}, "
                       f"p = {p:.3f}" + ("" if p < _SIGNIFICANCE else " (cannot tell apart)"))
             rank = r.get("rank")
-            return ["-" if fmt(rank) == "-" else str(int(rank)), r["method"], r["detector"],
+            why = r.get("not_ranked")
+            return [why if isinstance(why, str) and why else
+                    "-" if fmt(rank) == "-" else str(int(rank)),
+                    r["method"], r["detector"],
                     r["calibration"],
                     _rate(r, "precision"), _rate(r, "recall"), _rate(r, "accuracy"),
                     fmt(r.get("mean_detection_s")), fmt(r.get("max_detection_s")),

@@ -125,3 +125,29 @@ def test_a_subset_without_flights_has_no_rows_and_a_fully_excluded_run_is_named(
     notes = unscored_notes(table, failures, manifest, ["all", "emr"])
     assert f"`b` on `all`: all {len(flights)} flights excluded (calibration)" in notes
     assert "`a`" not in notes and "`emr`" not in notes
+
+
+def test_ranks_compare_runs_on_the_same_flights_and_never_a_silent_one(corpus_manifest):
+    """A run that scored fewer flights than the others, or never armed, is listed after
+    the ranked ones with the reason, however its accuracy compares."""
+    import pandas as pd
+
+    flights = corpus_manifest.loc[corpus_manifest["ground_truth"]]
+    first = flights["flight"].iloc[0]
+    records = []
+    for r in flights.itertuples():
+        onset = None if math.isnan(r.onset_s) else r.onset_s
+        records += [_record("fair", r.flight, onset, None if onset is None else onset + 9),
+                    {**_record("silent", r.flight, onset, None), "pair_armed_s": {"c": None}}]
+        if r.flight != first:       # perfect, but on one flight fewer
+            records.append(_record("partial", r.flight, onset,
+                                   None if onset is None else onset + 0.5))
+    failures = pd.DataFrame([{"flight": first, "stage": "detect", "method": "partial",
+                              "subsets": ""}])
+    table = comparison_table(records, corpus_manifest, ["all"], 5.0, failures)
+    table = table.set_index("method")
+    assert table.loc["fair", "rank"] == 1
+    assert math.isnan(table.loc["partial", "rank"]) and math.isnan(table.loc["silent", "rank"])
+    assert table.loc["partial", "not_ranked"] == f"scored on {len(flights) - 1} of {len(flights)}"
+    assert table.loc["silent", "not_ranked"] == "never armed"
+    assert list(table.index) == ["fair", "partial", "silent"]
