@@ -11,6 +11,9 @@ configfile: "config/config.yaml"
 validate(config, "config/schema.yaml")
 
 
+report: "report/workflow.rst"
+
+
 include: "rules/common.smk"
 include: "rules/data.smk"
 include: "rules/detect.smk"
@@ -19,6 +22,7 @@ include: "rules/sweep.smk"
 include: "rules/rerun.smk"
 include: "rules/paper.smk"
 include: "rules/inject.smk"
+include: "rules/report.smk"
 
 
 rule all:
@@ -36,3 +40,8 @@ rule all:
         rules.isolation.output,
         # the PDF where a LaTeX engine (latexmk + pdflatex) is installed
         rules.paper_pdf.output if LATEX else [],
+        # last: the run's provenance, with the checksum of everything above
+        RUN_FILE,
+
+
+include: "rules/provenance.smk"

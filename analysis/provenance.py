@@ -1,15 +1,22 @@
-"""What a result was made from: code version, packages, config, inputs, calibration.
+"""What a result was made from: code version, packages, config, data, calibration.
 
-Every result file records it (:func:`stamp`, :func:`read_provenance`): the project
-version and git commit, the package versions, the configuration it was made with,
-the SHA-256 of each input flight and the flights that calibrated each fold. The
-record is deterministic (sorted keys, no times), so it does not break byte-identical
-reruns.
+A provenance block holds the project version and git commit, the package versions,
+the configuration (with where the flights came from), the SHA-256 of each input
+flight and the flights that calibrated each fold. It is deterministic (sorted keys,
+no times), so it does not break byte-identical reruns.
+
+The run's block is written once, to :data:`RUN_FILE` (:func:`write_run_file`), with
+the SHA-256 of every output, so that tables stay plain: a CSV is RFC 4180 with its
+header on line 1, and a Markdown or LaTeX table ends with one short line naming the
+run (:func:`run_id`) and that file. Files that can carry metadata without getting in a
+reader's way carry their own block (:func:`stamp`): figures, traces, detection
+records, Parquet tables, recordings. :func:`read_provenance` reads either kind.
 """
 
 from __future__ import annotations
 
 import ast
+import hashlib
 import importlib
 import json
 import struct
@@ -24,10 +31,12 @@ import pandas as pd
 
 from .calibration import folds
 
-__all__ = ["PACKAGES", "code_version", "module_sources", "package_versions", "provenance",
-           "read_provenance", "read_table", "run_provenance", "stamp"]
+__all__ = ["PACKAGES", "RUN_FILE", "code_version", "file_sha256", "module_sources",
+           "package_versions", "provenance", "read_provenance", "read_table", "run_id",
+           "run_provenance", "stamp", "write_run_file"]
 
-_CSV_PREFIX = "# provenance: "
+#: where the run's provenance and every output's checksum are written
+RUN_FILE = "results/provenance.json"
 
 PACKAGES = ("alfa-bench", "numpy", "scipy", "pandas", "filterpy", "control", "scikit-learn",
             "rerun-sdk", "snakemake", "matplotlib")
@@ -140,21 +149,41 @@ def _png_text(data: bytes, key: str, text: str) -> bytes:
     return data[:end_of_ihdr] + chunk + data[end_of_ihdr:]
 
 
+def run_id(prov: dict) -> str:
+    """A short name of the run ``prov`` comes from: 12 digits of the SHA-256 of its code,
+    packages and config (which names where the flights came from), the same for every
+    file of the run whatever flights it was made of."""
+    run = {k: prov.get(k) for k in ("code", "packages", "config")}
+    return hashlib.sha256(_json(run).encode()).hexdigest()[:12]
+
+
+def file_sha256(path: str | Path) -> str:
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
 def stamp(path: str | Path, prov: dict) -> None:
-    """Record ``prov`` in the result file ``path``, in the way its format allows:
-    a first ``# provenance: {json}`` line (.csv), a ``%`` line (.tex), an HTML
-    comment (.md), a tEXt chunk (.png), a ``provenance.json`` member (.npz), a
-    ``provenance`` key (.json). Rerun recordings carry it as a recording property
-    (see :mod:`.rerun_log`), traces theirs as an array (see :mod:`.traces`)."""
+    """Record ``prov`` with the result file ``path``, in the way its format allows.
+    A CSV is left plain: :data:`RUN_FILE` holds its run's block and its checksum. A
+    Markdown or HTML page ends with one line naming the run and that file, a LaTeX
+    file starts with one as a comment. A PNG gets a tEXt chunk, a ``.json`` record a
+    ``provenance`` key. Rerun recordings carry it as a recording property (see
+    :mod:`.rerun_log`), traces theirs as an array (see :mod:`.traces`), Parquet tables
+    in their schema's metadata (see :mod:`.parquet`)."""
     path = Path(path)
     text = _json(prov)
     match path.suffix:
         case ".csv":
-            path.write_text(f"{_CSV_PREFIX}{text}\n" + path.read_text())
+            pass
         case ".tex":
-            path.write_text(f"% provenance: {text}\n" + path.read_text())
+            path.write_text(f"% run {run_id(prov)}; its provenance: {RUN_FILE}\n"
+                            + path.read_text())
         case ".md":
-            path.write_text(path.read_text() + f"\n<!-- provenance: {text} -->\n")
+            path.write_text(path.read_text() + f"\n*Run `{run_id(prov)}`: code, packages, "
+                            f"config, data and checksums in `{RUN_FILE}`.*\n")
+        case ".html":
+            path.write_text(path.read_text().replace("</body>", (
+                f"<p><em>Run <code>{run_id(prov)}</code>: code, packages, config, data and "
+                f"checksums in <code>{RUN_FILE}</code>.</em></p>\n</body>"), 1))
         case ".png":
             path.write_bytes(_png_text(path.read_bytes(), "provenance", text))
         case ".json":
@@ -165,16 +194,52 @@ def stamp(path: str | Path, prov: dict) -> None:
             raise ValueError(f"cannot record provenance in {path}")
 
 
+def write_run_file(path: str | Path, prov: dict, outputs, root: str | Path = ".",
+                   unchecked=()) -> None:
+    """Write the run's block ``prov`` to ``path`` with the SHA-256 of every file of
+    ``outputs`` (files or folders, under ``root``), by its path from ``root``; the
+    files matching a glob of ``unchecked`` are listed with no checksum (what differs
+    between runs by nature: clock-drawn ids, measured times)."""
+    root = Path(root)
+    files = sorted({f for o in map(Path, outputs) for f in
+                    ([o] if o.is_file() else (p for p in o.rglob("*") if p.is_file()))})
+    sums = {}
+    for f in files:
+        rel = f.resolve().relative_to(root.resolve()).as_posix()
+        sums[rel] = (None if any(Path(rel).match(g) for g in unchecked)
+                     else file_sha256(f))
+    Path(path).write_text(json.dumps({"run_id": run_id(prov), "run": prov,
+                                      "outputs": sums, "unchecked": list(unchecked)},
+                                     sort_keys=True, indent=1, allow_nan=False) + "\n")
+
+
+def _run_file_of(path: Path) -> tuple[dict, str]:
+    """The run file that lists ``path``, and ``path`` as it is named there."""
+    for root in path.resolve().parents:
+        run = root / RUN_FILE
+        if run.is_file():
+            return json.loads(run.read_text()), path.resolve().relative_to(root).as_posix()
+    raise ValueError(f"no {RUN_FILE} above {path}: it was not written by a whole run")
+
+
 def read_provenance(path: str | Path) -> dict:
-    """The provenance recorded in a result file (see :func:`stamp`)."""
+    """The provenance of a result file: its own (see :func:`stamp`), or for a CSV,
+    Markdown, HTML or LaTeX table that of the run file listing it, whose checksum it must
+    still match where one is recorded."""
     path = Path(path)
     match path.suffix:
-        case ".csv" | ".tex":
-            first = path.read_text().split("\n", 1)[0]
-            return json.loads(first.split("provenance: ", 1)[1])
-        case ".md":
-            last = path.read_text().rstrip().rsplit("\n", 1)[-1]
-            return json.loads(last.removeprefix("<!-- provenance: ").removesuffix(" -->"))
+        case ".csv" | ".tex" | ".md" | ".html":
+            run, name = _run_file_of(path)
+            if name not in run["outputs"]:
+                raise ValueError(f"{path} is not among the outputs of the run in {RUN_FILE}")
+            recorded = run["outputs"][name]
+            # an output that differs between runs by nature is listed without a checksum
+            if recorded is not None and recorded != file_sha256(path):
+                raise ValueError(f"{path} is no longer the file its run recorded in {RUN_FILE}")
+            return run["run"]
+        case ".parquet":
+            import pyarrow.parquet as pq
+            return json.loads(pq.read_schema(path).metadata[b"provenance"])
         case ".png":
             return json.loads(_png_chunks(path.read_bytes())[b"provenance"])
         case ".npz":
@@ -201,8 +266,5 @@ def _png_chunks(data: bytes) -> dict[bytes, str]:
 
 
 def read_table(path: str | Path, **kwargs) -> pd.DataFrame:
-    """A result CSV, without its provenance line (``kwargs`` go to pandas)."""
-    path = Path(path)
-    with path.open() as f:
-        skip = 1 if f.readline().startswith(_CSV_PREFIX) else 0
-    return pd.read_csv(path, skiprows=skip, **kwargs)
+    """A result CSV (``kwargs`` go to pandas): plain, as any tool reads it."""
+    return pd.read_csv(path, **kwargs)

@@ -31,12 +31,13 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["ViewerCheck", "check_screenshot", "chromium", "screenshot", "serve_recording"]
+__all__ = ["CHROMIUM_ARGS", "ViewerCheck", "check_screenshot", "chromium", "screenshot",
+           "serve_recording"]
 
 #: rerun's fill of a selected time span in the time panel (RGB), seen in 0.41
 SELECTION_RGB = (209, 225, 248)
 # Chromium in a sandbox without a GPU or a network: software WebGL, and no calls home
-_CHROMIUM_ARGS = ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+CHROMIUM_ARGS = ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
                   "--disable-background-networking", "--disable-component-update",
                   "--disable-sync", "--no-first-run"]
 
@@ -130,7 +131,7 @@ def screenshot(url: str, out: str | Path, *, size: tuple[int, int] = (1600, 1000
         raise RuntimeError("no Chromium: install Debian's chromium, or set CHROMIUM")
     out = Path(out)
     with sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=exe, headless=True, args=_CHROMIUM_ARGS)
+        browser = p.chromium.launch(executable_path=exe, headless=True, args=CHROMIUM_ARGS)
         try:
             page = browser.new_page(viewport={"width": size[0], "height": size[1]})
             page.goto(url)

@@ -1,9 +1,10 @@
 import os
+import sys
 from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
 
-from alfa_bench.analysis.provenance import module_sources
+from alfa_bench.analysis.provenance import RUN_FILE, module_sources
 from alfa_bench.methods import REGISTRY, make_detector
 
 METHODS = list(config["methods"])
@@ -39,11 +40,24 @@ def detector_code(method):
     return module_sources(REGISTRY[config["methods"][method]["detector"]])
 
 
+def figure_fault_class(wildcards):
+    """The report files each flight's figure under its fault class (from the manifest)."""
+    from alfa_bench.data import read_manifest
+
+    manifest = read_manifest("data/flights.csv").set_index("flight")
+    return manifest.at[wildcards.flight, "fault_class"]
+
+
 # ALFA_DIR, else the config's alfa_dir, else the downloaded archive.
 _alfa = os.environ.get("ALFA_DIR") or config.get("alfa_dir")
 DOWNLOAD = not _alfa
 ALFA_DIR = Path(config["download"]["dest"] if DOWNLOAD else _alfa)
 PROCESSED = ALFA_DIR / "processed"
+# where the flights came from, in every result's provenance (config is what it records)
+config["alfa_dir"] = str(ALFA_DIR)
+config["data_origin"] = (
+    f"downloaded: {config['download']['file']}, MD5 {config['download']['md5']}" if DOWNLOAD
+    else "ALFA_DIR" if os.environ.get("ALFA_DIR") else "config alfa_dir")
 
 
 wildcard_constraints:

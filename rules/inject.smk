@@ -42,7 +42,8 @@ rule detectability:
         detections=expand("results/injected/detections/{method}", method=DETECTORS),
         clean=expand("results/detections/{method}", method=DETECTORS),
     output:
-        csv=report("results/tables/detectability.csv", category="Sensor faults"),
+        csv=report("results/tables/detectability.csv",
+                   caption="../report/detectability_table.rst", category="Sensor faults"),
         md="results/tables/detectability.md",
         figure=report("results/figures/detectability.png",
                       caption="../report/detectability.rst", category="Sensor faults"),
@@ -63,9 +64,11 @@ rule isolation:
                                    method=DETECTORS),
     output:
         sensors_csv="results/tables/isolation_sensors.csv",
-        sensors_md=report("results/tables/isolation_sensors.md", category="Sensor faults"),
+        sensors_md=report("results/tables/isolation_sensors.md",
+                          caption="../report/sensor_faults.rst", category="Sensor faults"),
         actuators_csv="results/tables/isolation_actuators.csv",
-        actuators_md=report("results/tables/isolation_actuators.md", category="Tables"),
+        actuators_md=report("results/tables/isolation_actuators.md",
+                            caption="../report/isolation_actuators.rst", category="Comparison"),
     params:
         methods=DETECTORS,
     log:

@@ -31,7 +31,8 @@ rule paper_sources:
         markdown=PAPER_DIR / "paper.template.md",
     output:
         macros="paper/build/results.tex",
-        markdown=report("paper/build/paper.md", category="Manuscript"),
+        markdown=report("paper/build/paper.md", caption="../report/paper.rst",
+                        category="Manuscript"),
     log:
         "results/logs/paper_sources.log",
     script:

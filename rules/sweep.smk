@@ -6,7 +6,8 @@ rule sweep:
         detections=expand("results/detections/{method}", method=METHODS),
         traces=expand("results/traces/{method}", method=METHODS),
     output:
-        csv=report("results/tables/sweep.csv", category="Threshold sweeps"),
+        csv=report("results/tables/sweep.csv", caption="../report/sweep_table.rst",
+                   category="Threshold sweeps"),
         figure=report("results/figures/sweep.png", caption="../report/sweep.rst",
                       category="Threshold sweeps"),
     params:
@@ -28,7 +29,8 @@ rule flight_figures:
         traces=expand("results/traces/{method}", method=METHODS),
     output:
         report(directory("results/figures/flights"), patterns=["{flight}.png"],
-               caption="../report/flight.rst", category="Flights"),
+               caption="../report/flight.rst", category="Flights",
+               subcategory=figure_fault_class),
     log:
         "results/logs/flight_figures.log",
     script:

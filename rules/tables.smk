@@ -5,10 +5,14 @@ rule tables:
         detections=expand("results/detections/{method}", method=METHODS),
         leakage="results/tables/leakage.csv",
     output:
-        failures=report("results/tables/failures.csv", category="Tables"),
+        failures=report("results/tables/failures.csv", caption="../report/failures.rst",
+                        category="Comparison"),
         summary="results/tables/summary.csv",
         by_fault="results/tables/by_fault.csv",
-        comparison=report("results/tables/comparison.csv", category="Tables"),
+        comparison=report("results/tables/comparison.csv", caption="../report/comparison.rst",
+                          category="Comparison"),
+        comparison_html=report("results/tables/comparison.html",
+                               caption="../report/comparison.rst", category="Comparison"),
         summary_md="results/tables/summary.md",
         by_fault_md="results/tables/by_fault.md",
         comparison_md="results/tables/comparison.md",
@@ -33,6 +37,8 @@ rule per_flight:
     output:
         csv="results/tables/per_flight.csv",
         md="results/tables/per_flight.md",
+        parquet="results/tables/per_flight.parquet",
+        records="results/tables/detections.parquet",
     params:
         deadline_s=config["scoring"]["deadline_s"],
     log:
@@ -49,7 +55,9 @@ rule runtime:
         benchmarks=expand("results/benchmarks/detect/{method}.tsv", method=METHODS),
     output:
         csv="results/runtime/runtime.csv",
-        md=report("results/runtime/runtime.md", category="Runtime"),
+        md="results/runtime/runtime.md",
+        html=report("results/runtime/runtime.html", caption="../report/runtime.rst",
+                    category="Runtime"),
     log:
         "results/logs/runtime.log",
     script:
@@ -62,7 +70,8 @@ rule deadline:
         detections=expand("results/detections/{method}", method=METHODS),
     output:
         csv="results/tables/deadline.csv",
-        md=report("results/tables/deadline.md", category="Tables"),
+        md=report("results/tables/deadline.md", caption="../report/deadline_table.rst",
+                  category="Detection times"),
         figure=report("results/figures/deadline.png", caption="../report/deadline.rst",
                       category="Detection times"),
         detection_time=report("results/figures/detection_time.png",
@@ -71,6 +80,7 @@ rule deadline:
     params:
         subsets=SUBSETS,
         deadlines_s=config["scoring"]["deadlines_s"],
+        deadline_s=config["scoring"]["deadline_s"],
         subset=PRIMARY,
     log:
         "results/logs/deadline.log",
@@ -85,7 +95,9 @@ rule leakage:
         cache="results/cache",
     output:
         csv="results/tables/leakage.csv",
-        md=report("results/tables/leakage.md", category="Tables"),
+        md="results/tables/leakage.md",
+        html=report("results/tables/leakage.html", caption="../report/leakage.rst",
+                    category="Leakage audit"),
     log:
         "results/logs/leakage.log",
     script:

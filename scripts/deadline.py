@@ -19,7 +19,7 @@ table.to_csv(sm.output.csv, index=False)
 Path(sm.output.md).write_text(deadline_markdown(table))
 deadline_figure(table, sm.params.subset, sm.output.figure)
 detection_time_figure(records, subset_flights(manifest, sm.params.subset),
-                      sm.output.detection_time)
+                      float(sm.params.deadline_s), sm.output.detection_time)
 prov = run_provenance(sm.config, manifest)
 for path in sm.output:
     stamp(path, prov)

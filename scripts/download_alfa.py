@@ -4,7 +4,7 @@ import logging
 import sys
 
 from alfa_bench.analysis.logs import log_to
-from alfa_bench.data import fetch_alfa
+from alfa_bench.data import AlfaDataError, fetch_alfa
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
@@ -13,4 +13,12 @@ progress = logging.StreamHandler(sys.stderr)
 progress.setFormatter(logging.Formatter("download_alfa: %(message)s"))
 logging.getLogger("alfa_bench.data").addHandler(progress)
 d = sm.params.download
-fetch_alfa(d["api"], d["file"], d["dest"], d.get("md5"), d.get("sha256"))
+try:
+    fetch_alfa(d["api"], d["file"], d["dest"], d.get("md5"), d.get("sha256"))
+except AlfaDataError as e:
+    # the details to the log; to the terminal one message, what to do, no traceback
+    log = logging.getLogger("alfa_bench.data")
+    log.removeHandler(progress)
+    log.error("download failed: %s", e, exc_info=True)
+    print(f"download_alfa: {e}", file=sys.stderr)
+    sys.exit(1)

@@ -5,6 +5,7 @@ from pathlib import Path
 from alfa_bench.analysis.leakage import leakage_markdown, leakage_table
 from alfa_bench.analysis.logs import log_to
 from alfa_bench.analysis.provenance import run_provenance, stamp
+from alfa_bench.analysis.render import markdown_html
 from alfa_bench.data import load_cached, read_manifest
 
 sm = snakemake  # noqa: F821
@@ -14,6 +15,8 @@ flights = load_cached(sm.input.cache, manifest)
 table = leakage_table(flights)
 table.to_csv(sm.output.csv, index=False)
 Path(sm.output.md).write_text(leakage_markdown(table))
+Path(sm.output.html).write_text(markdown_html(Path(sm.output.md).read_text(),
+                                              "alfa-bench: leakage audit"))
 prov = run_provenance(sm.config, manifest)
 for path in sm.output:
     stamp(path, prov)

@@ -4,6 +4,7 @@ from pathlib import Path
 
 from alfa_bench.analysis import per_flight_markdown, per_flight_table, read_records
 from alfa_bench.analysis.logs import log_to
+from alfa_bench.analysis.parquet import records_table, write_parquet
 from alfa_bench.analysis.provenance import run_provenance, stamp
 from alfa_bench.analysis.traces import read_traces
 from alfa_bench.data import read_manifest
@@ -12,10 +13,13 @@ sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 manifest = read_manifest(sm.input.manifest)
 deadline = float(sm.params.deadline_s)
-table = per_flight_table(read_records(sm.input.detections),
-                         read_traces(sm.input.traces, probes=False), manifest, deadline)
+records = read_records(sm.input.detections)
+table = per_flight_table(records, read_traces(sm.input.traces, probes=False), manifest,
+                         deadline)
 table.to_csv(sm.output.csv, index=False)
 Path(sm.output.md).write_text(per_flight_markdown(table, deadline))
 prov = run_provenance(sm.config, manifest)
-for path in sm.output:
+write_parquet(table, sm.output.parquet, prov)
+write_parquet(records_table(records), sm.output.records, prov)
+for path in (sm.output.csv, sm.output.md):
     stamp(path, prov)

@@ -4,6 +4,7 @@ from pathlib import Path
 
 from alfa_bench.analysis.logs import log_to
 from alfa_bench.analysis.provenance import run_provenance, stamp
+from alfa_bench.analysis.render import markdown_html
 from alfa_bench.analysis.runtime import runtime_markdown, runtime_table
 from alfa_bench.data import read_manifest
 
@@ -15,6 +16,8 @@ flights, injected = ({Path(d).name: len(list(Path(d).glob("*.json"))) for d in f
 table = runtime_table(sm.input.benchmarks, flights, injected)
 table.to_csv(sm.output.csv, index=False)
 Path(sm.output.md).write_text(runtime_markdown(table))
+Path(sm.output.html).write_text(markdown_html(Path(sm.output.md).read_text(),
+                                              "alfa-bench: runtime"))
 prov = run_provenance(sm.config, read_manifest(sm.input.manifest))
 for path in sm.output:
     stamp(path, prov)

@@ -22,6 +22,7 @@ from alfa_bench.analysis import (
 from alfa_bench.analysis.leakage import audit_note
 from alfa_bench.analysis.logs import log_to
 from alfa_bench.analysis.provenance import read_table, run_provenance, stamp
+from alfa_bench.analysis.render import markdown_html
 from alfa_bench.analysis.tables import unscored_notes
 from alfa_bench.data import read_manifest
 
@@ -47,6 +48,8 @@ if audit.startswith("**WARNING"):
 Path(sm.output.comparison_md).write_text(comparison_markdown(
     comparison, unscored_notes(comparison, failures, manifest, sm.params.subsets),
     sm.params.primary, audit))
+Path(sm.output.comparison_html).write_text(markdown_html(
+    Path(sm.output.comparison_md).read_text(), "alfa-bench: comparison"))
 Path(sm.output.summary_tex).write_text(summary_latex(summary))
 Path(sm.output.by_fault_tex).write_text(by_fault_latex(by_fault))
 Path(sm.output.comparison_tex).write_text(comparison_latex(comparison))

@@ -154,3 +154,29 @@ def test_sensor_fault_numbers_come_from_the_grid_and_the_isolation_tables():
     assert n["bestsensor"] == "a" and n["sensorfaults"] == "2"
     assert n["sensorisolated:a"] == "50.00" and n["sensorisolated:c"] == "n/a"
     assert n["actuatorisolated:a"] == "n/a"
+
+
+#: settings, not results: the intervals' confidence level and the audit's quantile
+_TYPED_SETTINGS = {"95"}
+
+
+def _typed_results(text: str, percent: str) -> list[str]:
+    """Counts and rates typed in prose: ``k %``, ``k of n``, ``k flights``/``faults``."""
+    found = re.findall(rf"\b(\d+(?:\.\d+)?)\s*{percent}", text)
+    found += re.findall(r"\b\d+ of \d+\b", text)
+    found += re.findall(r"\b\d+~?\s*(?:labelled |fault-free |engine |fault )?"
+                        r"(?:flights?|faults?)\b", text)
+    return [f for f in found if f not in _TYPED_SETTINGS]
+
+
+def test_the_prose_types_no_count_or_rate():
+    """Every count and rate of the manuscript is quoted by key (the abstract once typed
+    "the 22 flights of that paper", wrong on any other flight set); equations, code
+    and references aside."""
+    md = re.sub(r"\{\{[^}]*\}\}|`[^`]*`", "", MARKDOWN.split("## References")[0])
+    md = "\n".join(line for line in md.splitlines() if not line.startswith("    "))
+    assert _typed_results(md, "%") == []
+    tex = re.sub(r"(?<!\\)%.*", "", TEX).split(r"\begin{thebibliography}")[0]
+    tex = re.sub(r"\\result\{[^}]*\}|\\texttt\{[^}]*\}|\$[^$]*\$", "", tex)
+    tex = re.sub(r"\\begin\{equation\}.*?\\end\{equation\}", "", tex, flags=re.S)
+    assert _typed_results(tex, r"\\,\\%") == []

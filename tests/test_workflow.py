@@ -16,7 +16,7 @@ from broken import IMU, ROLL, _gap, edit
 from loopback import make_archive, serve_archive
 from recordings import content
 
-from alfa_bench.analysis.provenance import read_provenance, read_table
+from alfa_bench.analysis.provenance import RUN_FILE, read_provenance, read_table
 from alfa_bench.analysis.traces import read_trace
 from alfa_bench.methods import REGISTRY, make_detector
 from synthetic import write_flight
@@ -185,6 +185,18 @@ def test_the_html_report_holds_the_figures_and_tables(runs, corpus):
     html = (work / "report.html").read_text()
     for name in ("sweep.png", "detection_time.png", "comparison.csv", "paper.md"):
         assert name in html, name
+    # in a real browser: it opens on the overview, the headline table and the figures show
+    from alfa_bench.analysis.report_page import open_report
+    from alfa_bench.analysis.viewer import chromium
+    if chromium() is None:
+        pytest.skip("no Chromium (apt-get install chromium): the report was not opened")
+    view = open_report(work / "report.html", work / "report.png", "Comparison",
+                       "results/tables/comparison.html")
+    assert "Start here." in view.overview and not view.errors
+    assert any("Headline: subset `no_emr`".replace("`", "") in f for f in view.frames)
+    view = open_report(work / "report.html", work / "report.png", "Detection times",
+                       "results/figures/detection_time.png")
+    assert view.images and min(view.images) > 100, view
 
 
 def test_the_honest_benchmark_outputs(runs):
@@ -228,9 +240,10 @@ def test_every_result_file_records_its_provenance(runs, corpus):
     files = [p for p in (work / "results").rglob("*") if p.is_file()
              and not p.name.startswith(".snakemake")     # Snakemake's directory markers
              and not {"logs", "benchmarks", "cache"} & set(p.relative_to(work).parts)
-             and p != work / "results/injected/flights.csv"]
+             and p not in (work / "results/injected/flights.csv", work / RUN_FILE)]
     files += [work / "paper/build/paper.md", work / "paper/build/results.tex"]
-    assert {p.suffix for p in files} == {".csv", ".md", ".tex", ".json", ".npz", ".png", ".rrd"}
+    assert {p.suffix for p in files} == {".csv", ".md", ".tex", ".json", ".npz", ".png", ".rrd",
+                                         ".parquet", ".html"}
     flights = {p.name for p in corpus.iterdir()}
     for path in files:
         prov = read_provenance(path)
@@ -418,3 +431,91 @@ def test_lint_asks_only_for_per_rule_software_environments(corpus, tmp_path):
     done = run_workflow(tmp_path, corpus.parent, "--lint", ok=False)
     titles = {line.strip() for line in done.stderr.splitlines() if line.startswith("    * ")}
     assert titles == {"* Specify a conda environment or container for each rule.:"}
+
+
+def _has_value(key: str, tables: dict) -> bool:
+    """Whether the run's tables hold the number that paper key ``key`` quotes."""
+    kind, *args = key.split(":")
+    comparison, by_fault = tables["comparison"], tables["by_fault"]
+    columns = {"precision": "precision", "recall": "recall", "accuracy": "accuracy",
+               "accuracypaper": "accuracy_paper", "recallpaper": "recall_paper",
+               "meandet": "mean_detection_s", "maxdet": "max_detection_s",
+               "detected": "tp", "falsealarms": "fault_free_flights"}
+    if kind in columns:
+        m, s = args
+        row = comparison[(comparison["method"] == m) & (comparison["subset"] == s)]
+        return bool(len(row)) and row[columns[kind]].notna().all()
+    if kind == "classdetected":
+        m, s, c = args
+        return bool(((by_fault["method"] == m) & (by_fault["subset"] == s)
+                     & (by_fault["fault_class"] == c)).any())
+    if kind in ("marginmax", "marginmin"):
+        rows = tables["per_flight"]
+        rows = rows[(rows["method"] == args[0]) & (rows["fault_class"] == args[1])]
+        return rows["margin_in_time"].notna().any()
+    if kind == "step":
+        leak = tables["leakage"]
+        return bool(((leak["signal"] == args[0]) & (leak["fault_class"] == args[1])
+                     & (leak["emergency_trajectory"] == (args[2] == "emr"))).any())
+    return False
+
+
+def test_the_paper_has_no_gap_where_the_tables_hold_the_number(runs):
+    """Every "n/a" of the rendered paper stands where the run's tables have no such
+    number (section 5's per-class counts once read n/a over a full by_fault table)."""
+    from alfa_bench.analysis.paper import paper_numbers
+    out = runs[0] / "results/tables"
+    tables = {n: read_table(out / f"{n}.csv") for n in
+              ("comparison", "by_fault", "per_flight", "leakage", "sweep")}
+    config = yaml.safe_load((REPO / "config/config.yaml").read_text())
+    numbers = paper_numbers(tables["comparison"], tables["sweep"], tables["leakage"],
+                            tables["by_fault"], tables["per_flight"],
+                            methods=list(config["methods"]), subsets=config["subsets"],
+                            primary=config["primary_subset"])
+    template = re.sub(r"<!--.*?-->", "", (REPO / "paper/paper.template.md").read_text(),
+                      flags=re.S)
+    quoted = re.findall(r"\{\{num:([^}]+)\}\}", template)
+    gaps = [k for k in dict.fromkeys(quoted) if numbers[k] == "n/a" and _has_value(k, tables)]
+    assert not gaps, gaps
+
+
+def test_a_failed_download_ends_on_what_to_do_without_a_traceback(tmp_path):
+    """No network (a closed loopback port): the terminal shows the download's message,
+    what to do, once and with no traceback; the log keeps the details."""
+    import socket
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]          # closed once the socket is
+    config = tmp_path / "offline.yaml"
+    config.write_text(yaml.safe_dump({"download": {
+        "api": f"http://127.0.0.1:{port}/files", "file": "processed.zip",
+        "md5": "0" * 32, "sha256": None, "dest": "resources/alfa"}}))
+    done = run_workflow(tmp_path, None, "--configfile", str(REPO / "config/config.yaml"),
+                        str(config), target="data/flights.csv", ok=False)
+    assert done.stderr.count("download_alfa: cannot reach") == 1, done.stderr
+    assert "Traceback" not in done.stderr and "set ALFA_DIR" in done.stderr, done.stderr
+    log = (tmp_path / "results/logs/download_alfa.log").read_text()
+    assert "Traceback" in log and "cannot reach" in log
+
+
+def test_every_csv_reads_plainly_with_its_documented_header(runs):
+    """pandas' and DuckDB's defaults read each CSV with the header docs/outputs.md lists
+    (a one-line provenance comment once made pandas see 410 columns)."""
+    import duckdb
+    import pandas as pd
+    documented = dict(re.findall(r"^- `([^`]+\.csv)`: (.+)$", (REPO / "docs/outputs.md")
+                                 .read_text(), flags=re.M))
+    work = runs[0]
+    found = sorted(p for p in [*(work / "results").rglob("*.csv"), *(work / "data").glob("*.csv")]
+                   if "detections" not in p.parts)
+    assert {p.relative_to(work).as_posix() for p in found} == set(documented)
+    for path in found:
+        header = re.findall(r"`([^`]+)`", documented[path.relative_to(work).as_posix()])
+        frame = pd.read_csv(path)
+        assert list(frame.columns) == header, path
+        if len(frame):          # a header alone is no table DuckDB can sniff a header in
+            table = duckdb.sql(f"select * from read_csv_auto('{path}')")
+            assert table.columns == header and len(table.fetchall()) == len(frame), path
+    for path in (work / "results/detections").glob("*/failures.csv"):
+        assert list(pd.read_csv(path).columns) == re.findall(
+            r"`([^`]+)`", documented["data/load_failures.csv"])[:-1], path

@@ -1,0 +1,18 @@
+# The run's provenance once, with every output's SHA-256: the tables stay plain files
+rule provenance:
+    input:
+        [f for f in rules.all.input if f != RUN_FILE],
+        manifest="data/flights.csv",
+        detections=expand("results/detections/{method}", method=METHODS),
+        traces=expand("results/traces/{method}", method=METHODS),
+        injected=expand("results/injected/detections/{method}", method=DETECTORS),
+        grid=rules.inject.output,
+    output:
+        RUN_FILE,
+    params:
+        # differ between runs by nature: rerun's clock-drawn ids, measured times
+        unchecked=["results/rerun/*.rrd", "results/runtime/*"],
+    log:
+        "results/logs/provenance.log",
+    script:
+        "../scripts/provenance.py"

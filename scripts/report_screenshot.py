@@ -1,0 +1,15 @@
+"""Snakemake script: a screenshot of the HTML report open on the comparison, checked in a
+browser."""
+
+import logging
+
+from alfa_bench.analysis.logs import log_to
+from alfa_bench.analysis.report_page import open_report
+
+sm = snakemake  # noqa: F821
+log_to(sm.log[0])
+view = open_report(sm.input[0], sm.output[0], "Comparison", "results/tables/comparison.html")
+if view.errors or not any("Headline: subset" in f for f in view.frames):
+    raise RuntimeError(f"the report did not show the comparison: {view.errors}; see "
+                       f"{sm.output[0]}")
+logging.getLogger("alfa_bench").info("report: the comparison is shown")
