@@ -20,11 +20,14 @@ Bad input policy (also in docs/bad-data.md):
   control surfaces other than its ground-truth topics, a row more than
   :data:`MAX_OUTSIDE_S` before the topics' median first row or after their median
   last row (a clock jump or a stray row that would move the flight clock or the
-  onset);
+  onset), a fault onset outside the span of the other topics (no data holds the
+  fault; scored, the flight would calibrate as fault-free); a file that starts with a
+  UTF-16 byte-order mark or holds NUL bytes (binary), named as such;
 - logged and kept: a label that names no fault class ALFA knows (the class is
   then read from the ground-truth topics alone);
 - repaired and logged (warning on the ``alfa_bench.data`` logger, and kept in
-  :attr:`Flight.repairs` so that results record it): a last line cut short
+  :attr:`Flight.repairs` so that results record it): a UTF-8 byte-order mark before
+  the header is dropped; a last line cut short
   (no final newline, as left by an interrupted copy) is dropped; rows that repeat
   the previous row's ``%time`` are dropped, keeping the last, since ROS
   re-publishes a message rather than sampling twice in one nanosecond.
@@ -51,8 +54,10 @@ __all__ = [
     "Flight",
     "Topic",
     "assemble_flight",
+    "entries",
     "find_flights",
     "load_flight",
+    "not_a_flight",
     "parse_flight_name",
 ]
 
@@ -247,21 +252,37 @@ class Flight:
                                     file=f"{self.id}-{name}.csv") from None
 
 
-def find_flights(processed: Path) -> list[Path]:
-    """Flight folders under ``processed``, sorted by name.
+def not_a_flight(entry: Path) -> str | None:
+    """Why the entry ``entry`` of a ``processed/`` folder is no flight folder to read
+    (a broken link, not a folder, unreadable, no ``<folder>-*.csv`` file), or None."""
+    if entry.is_symlink() and not entry.exists():
+        return "not a flight folder: a broken link, unreadable"
+    if not entry.is_dir():
+        return "not a flight folder: a file"
+    try:
+        found = any(entry.glob(f"{_glob_escape(entry.name)}-*.csv"))
+    except OSError as e:
+        return f"not a flight folder: unreadable ({e.strerror or e})"
+    return None if found else f"not a flight folder: no {entry.name}-<topic>.csv files"
 
-    A sub-folder without any ``<folder>-*.csv`` file is not a flight: it is
-    skipped with a warning.
-    """
+
+def entries(processed: Path) -> list[Path]:
+    """Every entry of ``processed`` but hidden ones (``.name``), sorted by name."""
     processed = Path(processed)
     if not processed.is_dir():
         raise AlfaDataError(f"no such folder: {processed}")
+    return sorted(p for p in processed.iterdir() if not p.name.startswith("."))
+
+
+def find_flights(processed: Path) -> list[Path]:
+    """Flight folders under ``processed``, sorted by name; any other entry is skipped
+    with a warning saying why (:func:`not_a_flight`)."""
     flights = []
-    for d in sorted(p for p in processed.iterdir() if p.is_dir()):
-        if any(d.glob(f"{_glob_escape(d.name)}-*.csv")):
-            flights.append(d)
+    for entry in entries(processed):
+        if (why := not_a_flight(entry)) is None:
+            flights.append(entry)
         else:
-            log.warning("skipped %s: not a flight folder (no %s-*.csv files)", d, d.name)
+            log.warning("skipped %s: %s", entry, why)
     return flights
 
 
@@ -345,9 +366,19 @@ def _ground_truth(flight: str, label: str, topics: dict[str, Topic]) -> Fault | 
     _check_label(flight, label, {_GROUND_TRUTH_TOPICS[t] for t in gt}, gt)
     codes = {t: tuple(dict.fromkeys(topics[t].values("field.data").astype(int).tolist()))
              for t in gt}
+    onset = min(float(topics[t].t[0]) for t in gt)
+    first_gt = min(gt, key=lambda t: float(topics[t].t[0]))
+    sensors = [tp for name, tp in topics.items() if not name.startswith("failure_status")]
+    if sensors and not (min(float(tp.t[0]) for tp in sensors) <= onset
+                        <= max(float(tp.t[-1]) for tp in sensors)):
+        last = max(float(tp.t[-1]) for tp in sensors)
+        raise AlfaDataError(f"the fault's onset ({onset:.2f} s on the flight clock) is outside "
+                            f"the recorded data (0 to {last:.2f} s): no data holds the fault",
+                            flight=flight, file=f"{flight}-{first_gt}.csv", column="%time",
+                            line=int(topics[first_gt].lines[0]))
     return Fault(
         fault_class="+".join(_GROUND_TRUTH_TOPICS[t] for t in gt),
-        onset_s=min(float(topics[t].t[0]) for t in gt),
+        onset_s=onset,
         end_s=max(float(topics[t].t[-1]) for t in gt),
         topics=tuple(gt),
         codes=codes,
@@ -405,6 +436,16 @@ def _read_topic(path: Path, flight: str, repairs: list[str]):
     data = path.read_bytes()
     if not data:
         raise fail("empty file (0 bytes)")
+    if data[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        raise fail("UTF-16 text (it starts with a UTF-16 byte-order mark); re-export it as "
+                   "UTF-8")
+    if b"\0" in data:
+        nul = data.index(b"\0")
+        raise fail(f"binary data, not CSV text (a NUL byte at offset {nul})")
+    if data.startswith(b"\xef\xbb\xbf"):
+        data = data[3:]
+        repairs.append(f"{file}: dropped the UTF-8 byte-order mark before the header")
+        log.warning("flight %s: %s", flight, repairs[-1])
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as e:

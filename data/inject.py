@@ -220,13 +220,24 @@ def injected_sha256(source_sha256: str, sensor: str, kind: str, magnitude: float
     return hashlib.sha256(json.dumps(spec, sort_keys=True).encode()).hexdigest()
 
 
+def _unreadable(flight: Flight, sensor: str) -> str | None:
+    """Why ``sensor``'s column of ``flight`` cannot be read, or None."""
+    sig = SIGNALS[sensor]
+    try:
+        flight.topics[sig.topic].values(sig.column)
+    except AlfaDataError as e:
+        return f"cannot be read: {e}"
+    return None
+
+
 def grid_specs(sources: dict[str, Flight], manifest, sensors, faults,
                onsets) -> tuple[list[dict], list[dict]]:
     """The fault specs of the grid: every fault-free flight of ``manifest`` (loaded in
     ``sources``) with every sensor of ``sensors`` corrupted by every fault of ``faults``
     (``{"kind", "magnitude"}``) from every onset of ``onsets`` (fractions of the
-    flight's duration). A sensor whose topic a flight lacks, or that the flight does not
-    measure (the manifest's ``not_measured``), is skipped there, with a warning.
+    flight's duration). A sensor whose topic a flight lacks, that the flight does not
+    measure (the manifest's ``not_measured``), or whose column cannot be read (a bad
+    cell: the error says where) is skipped there, with a warning.
     Returns the specs (``source``, ``sensor``, ``kind``, ``magnitude``, ``onset_s``),
     and the skipped ``{"flight", "sensor", "reason"}``."""
     specs, skipped = [], []
@@ -236,7 +247,8 @@ def grid_specs(sources: dict[str, Flight], manifest, sensors, faults,
         for sensor in sensors:
             reason = (f"no {SIGNALS[sensor].topic} topic"
                       if SIGNALS[sensor].topic not in source.topics else
-                      "not measured (constant over the flight)" if sensor in dead else None)
+                      "not measured (constant over the flight)" if sensor in dead else
+                      _unreadable(source, sensor))
             if reason:
                 log.warning("%s: %s: %s, so no faults injected", row.flight, sensor, reason)
                 skipped.append({"flight": row.flight, "sensor": sensor, "reason": reason})

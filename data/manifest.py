@@ -32,8 +32,8 @@ import pandas as pd
 
 from .cache import cache_path, write_cached
 from .errors import FAILURE_COLUMNS, AlfaDataError, failure_row
-from .flight import Flight, find_flights, load_flight, parse_flight_name
-from .signals import not_measured
+from .flight import Flight, entries, find_flights, load_flight, not_a_flight, parse_flight_name
+from .signals import check_physical, not_measured
 
 __all__ = ["ICRA22_LAST_DATE", "SUBSETS", "build_manifest", "flight_sha256", "manifest_of",
            "manifest_row", "name_subsets", "read_manifest", "scan_flights", "subset_flights",
@@ -123,6 +123,7 @@ def name_subsets(flight: str) -> str:
 
 def _row(path: Path, cache: Path | None) -> dict:
     flight = load_flight(path)
+    check_physical(flight)
     row = manifest_row(flight)
     if cache is not None:
         write_cached(flight, cache_path(cache, flight.id), row["sha256"])
@@ -133,11 +134,15 @@ def scan_flights(processed: str | Path, cache: str | Path | None = None
                  ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Load every flight under ``processed``: the validated manifest of those that
     load, and a failures table (:data:`~.errors.FAILURE_COLUMNS` and ``subsets``)
-    of those that do not, each also logged. With ``cache``, each flight that loads is
+    of those that do not, each also logged. Every entry of ``processed`` but hidden
+    ones is one or the other: one that is no flight folder (:func:`~.flight.
+    not_a_flight`) is a failure saying why. With ``cache``, each flight that loads is
     also written there (:mod:`.cache`)."""
     rows, failures = [], []
-    for path in find_flights(Path(processed)):
+    for path in entries(Path(processed)):
         try:
+            if (why := not_a_flight(path)) is not None:
+                raise AlfaDataError(why, flight=path.name)
             rows.append(_row(path, cache))
         except AlfaDataError as e:
             log.error("flight %s excluded: %s", path.name, e)

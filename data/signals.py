@@ -32,6 +32,17 @@ Every signal has a *kind*, by where it sits relative to ALFA's fault emulation:
 :func:`reads_actuators` tells, from a method's signal names alone, whether it reads
 such a signal; nobody sets it by hand. :func:`not_measured` finds signals that are
 constant over a whole flight (measured airspeed is 0 from 2018-09-11 on).
+
+Bad values and gaps that parse (also in docs/bad-data.md):
+
+- a value outside what its instrument can produce (:attr:`Signal.bounds`: a gyro's
+  full scale, an attitude angle's range, a servo pulse's; physics, never fitted on
+  flights) fails the flight at load, naming flight, file, column, line and value
+  (:func:`check_physical`);
+- a topic that :func:`sample` is asked for must cover the flight: start within
+  :data:`COVERAGE_S` of its first row and end within it of its last (in ALFA every
+  topic does within 1.1 s); one that starts late or stops early would silently
+  shorten the span scored, so it is an :class:`AlfaDataError` naming the topic.
 """
 
 from __future__ import annotations
@@ -43,11 +54,15 @@ import numpy as np
 from .errors import AlfaDataError
 from .flight import Flight
 
-__all__ = ["KINDS", "MAX_HOLD_S", "SIGNALS", "Sampled", "Signal", "not_measured", "reads_actuators",
-           "sample", "series"]
+__all__ = ["COVERAGE_S", "KINDS", "MAX_HOLD_S", "SIGNALS", "Sampled", "Signal", "check_physical",
+           "not_measured", "reads_actuators", "sample", "series"]
 
 #: The longest a row's value may be held on the sampling grid, s.
 MAX_HOLD_S = 1.0
+
+#: How much later than the flight's first row a topic that is read may start, and how
+#: much earlier than its last row it may end, s.
+COVERAGE_S = 5.0
 
 #: Signal kinds, by where they sit relative to the fault emulation (module docstring).
 KINDS = ("sensor", "setpoint", "actuator")
@@ -66,17 +81,32 @@ class Signal:
     kind: str
     minus: str | None = None
     unit: str = ""
+    #: the values the instrument can produce at all (``column``'s), from its physics or
+    #: a datasheet-like limit, never fitted on flights; None where no limit applies
+    bounds: tuple[float, float] | None = None
 
     def __post_init__(self):
         if self.kind not in KINDS:
             raise ValueError(f"signal kind must be one of {KINDS}, got {self.kind!r}")
 
 
+#: an attitude angle, deg: roll within a turn, pitch within a quarter turn, heading
+#: within one turn either way of its origin
+_ANGLE_BOUNDS = {"roll": (-180.0, 180.0), "pitch": (-90.0, 90.0), "yaw": (-360.0, 360.0)}
+#: a MEMS gyro's widest full scale, ±2000 deg/s, in rad/s
+_RATE_BOUNDS = (-34.91, 34.91)
+#: a MEMS accelerometer's widest full scale, ±16 g, in m/s^2
+_ACCEL_BOUNDS = (-156.9, 156.9)
+#: an RC servo pulse, µs (the standard 1000-2000 µs, extended)
+_PWM_BOUNDS = (500.0, 2500.0)
+
+
 def _attitude(axis: str) -> dict[str, Signal]:
     topic = f"mavros-nav_info-{axis}"
+    bounds = _ANGLE_BOUNDS[axis]
     return {
-        f"{axis}_cmd": Signal(topic, "field.commanded", "setpoint", unit="deg"),
-        axis: Signal(topic, "field.measured", "sensor", unit="deg"),
+        f"{axis}_cmd": Signal(topic, "field.commanded", "setpoint", unit="deg", bounds=bounds),
+        axis: Signal(topic, "field.measured", "sensor", unit="deg", bounds=bounds),
         # measured minus commanded: a setpoint's deviation, fresh with the measurement
         f"{axis}_error": Signal(topic, "field.measured", "setpoint", minus="field.commanded",
                                 unit="deg"),
@@ -88,35 +118,44 @@ SIGNALS: dict[str, Signal] = {
     **_attitude("roll"),
     **_attitude("pitch"),
     **_attitude("yaw"),
+    # a small aircraft's pitot reads 0 to a few tens of m/s; 100 m/s is past any Carbon Z
     "airspeed_cmd": Signal("mavros-nav_info-airspeed", "field.commanded", "setpoint",
-                           unit="m/s"),
-    "airspeed": Signal("mavros-nav_info-airspeed", "field.measured", "sensor", unit="m/s"),
+                           unit="m/s", bounds=(0.0, 100.0)),
+    "airspeed": Signal("mavros-nav_info-airspeed", "field.measured", "sensor", unit="m/s",
+                       bounds=(0.0, 100.0)),
     # the autopilot's own altitude error (target minus measured): the energy its
     # throttle is asked to make up
-    "altitude_error": Signal("mavros-nav_info-errors", "field.alt_error", "setpoint", unit="m"),
+    "altitude_error": Signal("mavros-nav_info-errors", "field.alt_error", "setpoint", unit="m",
+                             bounds=(-5000.0, 5000.0)),
     # body rates from the raw IMU, the freshest sensor in ALFA (~10 Hz, every row new)
     "roll_rate": Signal("mavros-imu-data_raw", "field.angular_velocity.x", "sensor",
-                        unit="rad/s"),
+                        unit="rad/s", bounds=_RATE_BOUNDS),
     "pitch_rate": Signal("mavros-imu-data_raw", "field.angular_velocity.y", "sensor",
-                         unit="rad/s"),
+                         unit="rad/s", bounds=_RATE_BOUNDS),
     "yaw_rate": Signal("mavros-imu-data_raw", "field.angular_velocity.z", "sensor",
-                       unit="rad/s"),
+                       unit="rad/s", bounds=_RATE_BOUNDS),
     # specific force in body axes from the same IMU rows: thrust minus drag along x,
     # sideslip along y (gravity included: x reads g sin(pitch) in steady flight)
     "accel_x": Signal("mavros-imu-data_raw", "field.linear_acceleration.x", "sensor",
-                      unit="m/s^2"),
+                      unit="m/s^2", bounds=_ACCEL_BOUNDS),
     "accel_y": Signal("mavros-imu-data_raw", "field.linear_acceleration.y", "sensor",
-                      unit="m/s^2"),
+                      unit="m/s^2", bounds=_ACCEL_BOUNDS),
     # servo outputs (~3 Hz). ALFA does not name the channels; the mapping follows the
     # data: channels4 and 5 track roll rate (ailerons, r ~ 0.6-0.9), channels1 pitch rate
     # (elevator), channels2 drops to idle at every engine failure (throttle), channels3
     # is the one left (rudder); channels0, 6 and 7 never move.
-    "servo_elevator": Signal("mavros-rc-out", "field.channels1", "actuator", unit="us"),
-    "servo_throttle": Signal("mavros-rc-out", "field.channels2", "actuator", unit="us"),
-    "servo_rudder": Signal("mavros-rc-out", "field.channels3", "actuator", unit="us"),
-    "servo_aileron_left": Signal("mavros-rc-out", "field.channels4", "actuator", unit="us"),
-    "servo_aileron_right": Signal("mavros-rc-out", "field.channels5", "actuator", unit="us"),
-    "throttle": Signal("mavros-vfr_hud", "field.throttle", "actuator", unit="1"),
+    "servo_elevator": Signal("mavros-rc-out", "field.channels1", "actuator", unit="us",
+                             bounds=_PWM_BOUNDS),
+    "servo_throttle": Signal("mavros-rc-out", "field.channels2", "actuator", unit="us",
+                             bounds=_PWM_BOUNDS),
+    "servo_rudder": Signal("mavros-rc-out", "field.channels3", "actuator", unit="us",
+                           bounds=_PWM_BOUNDS),
+    "servo_aileron_left": Signal("mavros-rc-out", "field.channels4", "actuator", unit="us",
+                                 bounds=_PWM_BOUNDS),
+    "servo_aileron_right": Signal("mavros-rc-out", "field.channels5", "actuator", unit="us",
+                                  bounds=_PWM_BOUNDS),
+    "throttle": Signal("mavros-vfr_hud", "field.throttle", "actuator", unit="1",
+                       bounds=(0.0, 1.0)),
 }
 
 
@@ -190,6 +229,39 @@ def not_measured(flight: Flight, names=None) -> tuple[str, ...]:
     return tuple(dead)
 
 
+def check_physical(flight: Flight) -> None:
+    """Raise :class:`AlfaDataError` at the first value of a catalogue signal's column
+    outside its :attr:`Signal.bounds` (module docstring). A column that cannot be read
+    is passed over: it is an error only for a method that reads it."""
+    for name, sig in SIGNALS.items():
+        if sig.bounds is None or sig.topic not in flight.topics:
+            continue
+        tp = flight.topics[sig.topic]
+        try:
+            value = tp.values(sig.column)
+        except AlfaDataError:
+            continue
+        lo, hi = sig.bounds
+        out = (value < lo) | (value > hi)
+        if out.any():
+            i = int(np.argmax(out))
+            raise AlfaDataError(
+                f"{value[i]:.6g} {sig.unit} is outside what {name} can read ({lo:g} to "
+                f"{hi:g} {sig.unit}): not a physical value", flight=flight.id, file=tp.file,
+                column=sig.column, line=int(tp.lines[i]))
+
+
+def _check_coverage(flight: Flight, tp) -> None:
+    late = float(tp.t[0])
+    early = flight.duration_s - float(tp.t[-1])
+    if late > COVERAGE_S or early > COVERAGE_S:
+        what = (f"starts {late:.1f} s after the flight's first row" if late > COVERAGE_S
+                else f"ends {early:.1f} s before the flight's last row")
+        raise AlfaDataError(f"topic {what} (limit {COVERAGE_S:g} s): scored, it would "
+                            "shorten the span judged", flight=flight.id, file=tp.file,
+                            column="%time", line=int(tp.lines[0 if late > COVERAGE_S else -1]))
+
+
 def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float,
            max_hold_s: float = MAX_HOLD_S) -> Sampled:
     """Sample the named signals of ``flight`` at ``rate_hz`` (causal hold)."""
@@ -199,6 +271,8 @@ def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float,
         raise AlfaDataError(f"unknown signal(s) {unknown}; known: {sorted(SIGNALS)}",
                             flight=flight.id)
     topics = [flight.topic(SIGNALS[n].topic) for n in names]
+    for tp in dict.fromkeys(topics):
+        _check_coverage(flight, tp)
     start = max(float(tp.t[0]) for tp in topics)
     stop = min(float(tp.t[-1]) for tp in topics)
     k = np.arange(np.ceil(start * rate_hz), np.floor(stop * rate_hz) + 1)

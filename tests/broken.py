@@ -2,8 +2,8 @@
 
 Every case corrupts a copy of one valid synthetic engine-failure flight (onset
 50 s) in one way. :func:`outcome` runs the per-flight part of the pipeline on a
-folder (find, load, manifest row, and a detector reading the attitude, servo and
-IMU topics) and says how it ended; each case states the outcome it must have:
+folder (find, load, the physical bounds, manifest row, and a detector reading the
+attitude, servo and IMU topics) and says how it ended; each case states the outcome it must have:
 
 ``error``
     an :class:`~alfa_bench.data.AlfaDataError` naming the flight, and the file,
@@ -29,6 +29,7 @@ import numpy as np
 
 from alfa_bench.data import AlfaDataError, find_flights, load_flight
 from alfa_bench.data.manifest import manifest_row
+from alfa_bench.data.signals import check_physical
 from alfa_bench.methods import make_detector, run_detector
 
 NAME = "carbonZ_2018-07-18-15-53-31_1_engine_failure"
@@ -135,6 +136,22 @@ def _fast(lines: list[str]) -> list[str]:
     return [lines[0]] + [shift_time(line, k * 1_000_000) for line in lines[1:] for k in range(3)]
 
 
+def _bytes(topic: str, fn: Callable[[bytes], bytes]) -> Callable[[Path], Path]:
+    """A corruption that rewrites the bytes of ``topic``."""
+    def corrupt(folder: Path) -> Path:
+        path = topic_file(folder, topic)
+        path.write_bytes(fn(path.read_bytes()))
+        return folder
+    return corrupt
+
+
+def _late_start(lines: list[str]) -> list[str]:
+    """Drop the first 30 s of rows: a topic whose recording started late."""
+    t = np.array([int(line.split(",")[0]) for line in lines[1:]])
+    return [lines[0]] + [line for line, s in zip(lines[1:], (t - t[0]) * 1e-9, strict=True)
+                         if s >= 30.0]
+
+
 def _not_a_flight(folder: Path) -> Path:
     other = folder.with_name("notes")
     other.mkdir()
@@ -184,6 +201,21 @@ CASES = [
     Case("folder name that is not an ALFA name", _rename("my_flight"),
          Expect("error", "not an ALFA flight name")),
     Case("folder that is not a flight", _not_a_flight, Expect("skipped", "not a flight folder")),
+    Case("UTF-8 byte-order mark", _bytes(ROLL, lambda b: b"\xef\xbb\xbf" + b),
+         Expect("repair", "dropped the UTF-8 byte-order mark")),
+    Case("UTF-16 file", _bytes(ROLL, lambda b: b.decode().encode("utf-16")),
+         Expect("error", "UTF-16 text", ROLL)),
+    Case("binary file", _bytes(ROLL, lambda b: b[:40] + b"\0\x01\x02" + b[40:]),
+         Expect("error", "binary data, not CSV text (a NUL byte at offset 40)", ROLL)),
+    Case("gyro sample no gyro can read",
+         edit(IMU, lambda ls: ls[:9] + [set_cell(ls[9], 4, "1e12")] + ls[10:]),
+         Expect("error", "outside what roll_rate can read", IMU, "field.angular_velocity.x",
+                10)),
+    Case("onset after the last sensor row",
+         edit(GT, lambda ls: ls[:1] + [shift_time(line, 35 * 10**9) for line in ls[1:]]),
+         Expect("error", "outside the recorded data", GT, "%time", 2)),
+    Case("topic that starts 30 s late", edit(IMU, _late_start),
+         Expect("error", "starts 30.5 s after the flight's first row", IMU, "%time", 2)),
 ]
 
 
@@ -195,6 +227,7 @@ def outcome(folder: Path) -> tuple[str, object]:
         if not find_flights(folder.parent):
             return "skipped", None
         flight = load_flight(folder)
+        check_physical(flight)
         row = manifest_row(flight)
         if not row["ground_truth"]:
             return "excluded", flight
