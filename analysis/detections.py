@@ -136,7 +136,11 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
             continue
         log.info("%s: fold %s fitted on %d flights", method, fold, len(used))
         info = {**calibration, "fold": fold, "flights": used, "not_measured": dead,
-                "supervised": detector.supervised, "fitted": detector.fitted()}
+                "supervised": detector.supervised,
+                # what reached fit, flight by flight: the spans of its segments, s
+                "segments": {f: [[float(x.t[0]), float(x.t[-1])] for x in segments[f]]
+                             for f in used},
+                "fitted": detector.fitted()}
         for name in scored:
             if (out := run(name, info)) is not None:
                 yield out

@@ -27,6 +27,7 @@ code version that wrote the file) and ``provenance`` (the run's provenance as JS
 from __future__ import annotations
 
 import json
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -34,13 +35,15 @@ import rerun as rr
 import rerun.blueprint as rrb
 import rerun.chunk as rc
 
-from alfa_bench.data import SIGNALS, Flight, series
+from alfa_bench.data import SIGNALS, AlfaDataError, Flight, series
 from alfa_bench.methods import Trace
 
 from .provenance import code_version
 from .sweep import ratio
 
 __all__ = ["TIMELINE", "blueprint", "read_rerun_provenance", "signal_group", "write_rerun_log"]
+
+log = logging.getLogger(__name__)
 
 TIMELINE = "flight_time"
 _APPLICATION = "alfa-bench"
@@ -129,10 +132,17 @@ def _events(flight: Flight, traces: dict[str, Trace]) -> list[tuple[float, str, 
 def write_rerun_log(flight: Flight, traces: dict[str, Trace], signals: list[str],
                     path: str | Path, provenance: dict) -> None:
     """Write the recording of ``flight`` with the ``traces`` of each method (with
-    probes), the raw ``signals`` and the run's ``provenance`` to ``path``."""
+    probes), the raw ``signals`` and the run's ``provenance`` to ``path``. A signal the
+    flight cannot give (a column a method excluded it for) is left out, and logged."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    groups = [g for g in _GROUPS if any(signal_group(s) == g for s in signals)]
+    raw = {}
+    for s in signals:
+        try:
+            raw[s] = series(flight, s)
+        except AlfaDataError as e:
+            log.warning("%s: signal %s not recorded: %s", flight.id, s, e)
+    groups = [g for g in _GROUPS if any(signal_group(s) == g for s in raw)]
     rec = rr.RecordingStream(_APPLICATION, recording_id=flight.id, send_properties=False)
     fault = flight.fault
     span = (None if fault is None or fault.onset_s is None
@@ -149,8 +159,7 @@ def write_rerun_log(flight: Flight, traces: dict[str, Trace], signals: list[str]
     rec.send_property("provenance", rr.AnyValues(
         json=json.dumps(provenance, sort_keys=True, allow_nan=False)))
 
-    for s in signals:
-        t, v = series(flight, s)
+    for s, (t, v) in raw.items():
         _series(rec, f"signals/{signal_group(s)}/{s}", t, v, s, step=True)
     for method, tr in traces.items():
         base = f"methods/{method}"

@@ -175,6 +175,10 @@ class Labelled:
     def flight(self) -> str:
         return self.sampled.flight
 
+    @property
+    def t(self) -> np.ndarray:
+        return self.sampled.t
+
 
 @dataclass(frozen=True)
 class Trace:

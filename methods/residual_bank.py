@@ -35,7 +35,8 @@ the flight, and while either window holds no fresh residual.
 Thresholds count false alarms per flight, not per sample. For each channel the
 maxima :math:`M_{c,j} = \max_t s_c(t)` over the fault-free training segments
 :math:`j` (whole fault-free flights, and the others up to onset) are fitted with a
-Gumbel law, and
+Gumbel law, each capped first so that one extreme flight moves it little
+(:func:`gumbel_threshold`), and
 
 .. math::
 
@@ -118,6 +119,9 @@ _REGRESSOR = re.compile(r"^(?:(sin|tan|sq)\()?([a-z_]+)\)?$")
 
 #: fewer per-flight maxima than this cannot fit a two-parameter law
 MIN_SEGMENTS = 3
+#: per-flight maxima are capped at this quantile of the law their quartiles give
+#: (:func:`gumbel_threshold`): one fault-free flight in a thousand would exceed it
+CAP_LEVEL = 0.999
 
 
 @cache          # parsed once per name, not at every streaming step
@@ -135,12 +139,31 @@ def window_steps(seconds: float, rate_hz: float) -> int:
     return max(1, round(seconds * rate_hz))
 
 
+def _gumbel_unit(p: float) -> float:
+    """The Gumbel law's quantile function in units of its scale: Q(p) = mu + beta g(p)."""
+    return -math.log(-math.log(p))
+
+
 def gumbel_threshold(maxima: np.ndarray, level: float) -> float:
-    """The ``level`` quantile of a Gumbel law fitted (maximum likelihood) to the
-    per-flight ``maxima``."""
+    r"""The ``level`` quantile of a Gumbel law fitted (maximum likelihood) to the
+    per-flight ``maxima``, each capped first so that one extreme flight cannot move it
+    far. The cap is the :data:`CAP_LEVEL` quantile of the law fitted by the quartiles
+    :math:`q_p`, which one flight moves by at most one order statistic:
+
+    .. math::
+
+        \mathrm{cap} = q_{1/2} + (q_{3/4} - q_{1/4})\,
+        \frac{g(p_{\mathrm{cap}}) - g(1/2)}{g(3/4) - g(1/4)}, \qquad g(p) = -\ln(-\ln p).
+
+    Maxima like the others lie far below it, and are fitted as they are; an absurd one
+    weighs as a flight at the cap does."""
     from scipy import stats  # ~0.5 s to import: only where a Gumbel law is fitted
 
-    loc, scale = stats.gumbel_r.fit(np.asarray(maxima, dtype=float))
+    maxima = np.asarray(maxima, dtype=float)
+    q1, q2, q3 = np.quantile(maxima, [0.25, 0.5, 0.75])
+    cap = q2 + (q3 - q1) * (_gumbel_unit(CAP_LEVEL) - _gumbel_unit(0.5)) / (
+        _gumbel_unit(0.75) - _gumbel_unit(0.25))
+    loc, scale = stats.gumbel_r.fit(np.minimum(maxima, cap))
     return float(stats.gumbel_r.ppf(level, loc, scale))
 
 

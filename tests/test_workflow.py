@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-from broken import IMU, ROLL, _gap, edit
+from broken import GT, IMU, ROLL, _gap, _late_start, edit, set_cell, shift_time
 from loopback import make_archive, serve_archive
 from recordings import content
 
@@ -519,3 +519,79 @@ def test_every_csv_reads_plainly_with_its_documented_header(runs):
     for path in (work / "results/detections").glob("*/failures.csv"):
         assert list(pd.read_csv(path).columns) == re.findall(
             r"`([^`]+)`", documented["data/load_failures.csv"])[:-1], path
+
+
+@pytest.fixture(scope="module")
+def damaged(corpus, overlay, tmp_path_factory):
+    """`snakemake all --keep-going` over the corpus plus one flight of each kind of
+    damage: the run's folder, the damaged flights, and those refused at load."""
+    root = tmp_path_factory.mktemp("damaged")
+    processed = root / "processed"
+    shutil.copytree(corpus, processed)
+
+    def flight(name, **kw):
+        return write_flight(processed, name, seed=len(list(processed.iterdir())) + 20, **kw)
+
+    nan_cell = flight("carbonZ_2018-07-30-16-39-00_3_no_failure")
+    edit(ROLL, lambda ls: ls[:7] + [set_cell(ls[7], 5, "nan")] + ls[8:])(nan_cell)
+    late = flight("carbonZ_2018-09-11-14-22-07_1_engine_failure", onset_s=50.0)
+    edit(IMU, _late_start)(late)
+    onset_out = flight("carbonZ_2018-09-11-11-56-30_engine_failure", onset_s=50.0)
+    edit(GT, lambda ls: ls[:1] + [shift_time(line, 35 * 10**9) for line in ls[1:]])(onset_out)
+    spike = flight("carbonZ_2018-10-05-14-34-20_2_no_failure")
+    edit(IMU, lambda ls: ls[:9] + [set_cell(ls[9], 4, "1e12")] + ls[10:])(spike)
+    bom = flight("carbonZ_2018-07-18-16-37-39_2_no_failure")
+    path = bom / f"{bom.name}-{ROLL}.csv"
+    path.write_bytes(b"\xef\xbb\xbf" + path.read_bytes())
+    os.symlink(root / "gone", processed / "carbonZ_2018-09-11-14-41-51_elevator_failure")
+    write_flight(processed, "not_an_alfa_name", onset_s=50.0)
+    work = root / "run"
+    work.mkdir()
+    run_workflow(work, processed.parent, "--keep-going", "--configfile",
+                 str(REPO / "config/config.yaml"), str(overlay[0]))
+    refused = {onset_out.name, spike.name, "not_an_alfa_name",
+               "carbonZ_2018-09-11-14-41-51_elevator_failure"}
+    return work, refused | {nan_cell.name, bom.name, late.name}, refused
+
+
+def test_a_corpus_of_every_damage_runs_to_the_end_and_scores_every_clean_flight(damaged,
+                                                                               corpus):
+    work, _, refused = damaged
+    config = yaml.safe_load((REPO / "config/config.yaml").read_text())
+    clean = {p.name for p in corpus.iterdir()}
+    for method in config["methods"]:
+        scored = {p.stem for p in (work / "results/detections" / method).glob("*.json")}
+        assert clean <= scored, method
+        assert not scored & refused
+    failures = read_table(work / "results/tables/failures.csv", keep_default_na=False)
+    why = failures.groupby("flight")["error"].apply(" | ".join)
+    assert "outside the recorded data" in why["carbonZ_2018-09-11-11-56-30_engine_failure"]
+    assert "outside what roll_rate can read" in why["carbonZ_2018-10-05-14-34-20_2_no_failure"]
+    assert "starts 30.5 s after" in why["carbonZ_2018-09-11-14-22-07_1_engine_failure"]
+    assert "a broken link" in why["carbonZ_2018-09-11-14-41-51_elevator_failure"]
+    assert "not an ALFA flight name" in why["not_an_alfa_name"]
+    assert "empty or NaN cell" in why["carbonZ_2018-07-30-16-39-00_3_no_failure"]
+    skipped = read_table(work / "results/injected/skipped.csv")
+    assert "carbonZ_2018-07-30-16-39-00_3_no_failure" in set(skipped["flight"])
+    recorded = {p.stem for p in (work / "results/rerun").glob("*.rrd")}
+    assert clean - {p for p in clean if "no_ground_truth" in p} <= recorded
+
+
+def test_a_damaged_flight_moves_no_clean_flight_but_through_calibration(damaged, runs, corpus):
+    """The clean flights' outcomes equal a run without the damaged flights, or differ
+    only where a damaged flight the checks accepted (a repair, a bad column the method
+    does not read) calibrated them, as the record says; a refused flight calibrates
+    nothing."""
+    work, damaged_flights, refused = damaged
+    config = yaml.safe_load((REPO / "config/config.yaml").read_text())
+    for method in config["methods"]:
+        for flight in sorted(p.name for p in corpus.iterdir()):
+            a = runs[0] / "results/detections" / method / f"{flight}.json"
+            if not a.exists():
+                continue
+            before, after = json.loads(a.read_text()), json.loads(
+                (work / "results/detections" / method / f"{flight}.json").read_text())
+            used = set((after.get("calibration") or {}).get("flights", []))
+            assert not used & refused, (method, flight)
+            if before["first_alarm_s"] != after["first_alarm_s"]:
+                assert used & damaged_flights, (method, flight)
