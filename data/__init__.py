@@ -2,7 +2,16 @@
 
 from .cache import load_cached, read_cached
 from .download import fetch_alfa, processed_dir, resolve_alfa_dir
-from .errors import FAILURE_COLUMNS, AlfaDataError, MissingTopicError, failure_row
+from .errors import (
+    FAILURE_COLUMNS,
+    AlfaDataError,
+    DownloadError,
+    MissingFolderError,
+    MissingTopicError,
+    StaleCacheError,
+    UnknownSignalError,
+    failure_row,
+)
 from .flight import FAULT_CLASSES, Fault, Flight, Topic, find_flights, load_flight
 from .manifest import (
     SUBSETS,
@@ -26,7 +35,8 @@ from .signals import (
 
 __all__ = [
     "FAILURE_COLUMNS", "FAULT_CLASSES", "KINDS", "MAX_HOLD_S", "SIGNALS", "SUBSETS",
-    "AlfaDataError", "Fault", "Flight", "MissingTopicError", "Sampled", "Signal", "Topic",
+    "AlfaDataError", "DownloadError", "Fault", "Flight", "MissingFolderError",
+    "MissingTopicError", "Sampled", "Signal", "StaleCacheError", "Topic", "UnknownSignalError",
     "build_manifest", "failure_row", "fetch_alfa", "find_flights", "load_cached",
     "load_flight",
     "name_subsets", "not_measured", "processed_dir", "read_manifest", "reads_actuators",

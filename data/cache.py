@@ -3,7 +3,7 @@ milliseconds by every job that needs it.
 
 Parsing a flight's CSVs costs far more than any detector spends on it, and every
 detect job, the leakage audit, the rerun recordings and the injected benchmark read
-the same flights. The manifest rule therefore writes, beside ``data/flights.csv``,
+the same flights. The manifest rule therefore writes, beside ``results/flights.csv``,
 one ``<flight>.npz`` per flight it could read: every topic's record times, line
 numbers and ``field.*`` columns as typed arrays (no pickled objects), and a JSON
 header with the flight's folder, clock, repairs and the SHA-256 of its files, the
@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .errors import AlfaDataError
+from .errors import StaleCacheError
 from .flight import Flight, Topic, assemble_flight
 
 __all__ = ["cache_path", "load_cached", "read_cached", "write_cached", "write_npz"]
@@ -89,15 +89,15 @@ def read_cached(path: str | Path, sha256: str | None = None) -> Flight:
 
     Raises
     ------
-    AlfaDataError
+    StaleCacheError
         If the cache holds another version of the flight than ``sha256`` names.
     """
     with np.load(path, allow_pickle=False) as z:
         meta = json.loads(str(z["meta"]))
         if sha256 is not None and meta["sha256"] != sha256:
-            raise AlfaDataError(f"the parsed-flight cache {path} is of files with SHA-256 "
-                                f"{meta['sha256']}, the manifest says {sha256}: re-run "
-                                "the manifest rule", flight=meta["flight"])
+            raise StaleCacheError(f"flight {meta['flight']}: the parsed-flight cache {path} is "
+                                  f"of files with SHA-256 {meta['sha256']}, the manifest says "
+                                  f"{sha256}: re-run the manifest rule")
         arrays = {key: z[key] for key in z.files if key != "meta"}
     topics = {}
     for i, spec in enumerate(meta["topics"]):

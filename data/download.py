@@ -27,7 +27,7 @@ import urllib.request
 import zipfile
 from pathlib import Path, PurePosixPath
 
-from .errors import AlfaDataError
+from .errors import DownloadError, MissingFolderError
 
 __all__ = ["ARTICLE_URL", "download_archive", "fetch_alfa", "processed_dir", "resolve_alfa_dir",
            "unpack"]
@@ -53,7 +53,7 @@ def processed_dir(alfa_dir: str | os.PathLike) -> Path:
     """``alfa_dir/processed``, checked to exist."""
     processed = Path(alfa_dir) / "processed"
     if not processed.is_dir():
-        raise AlfaDataError(f"{processed} does not exist: ALFA_DIR (or alfa_dir in the "
+        raise MissingFolderError(f"{processed} does not exist: ALFA_DIR (or alfa_dir in the "
                             "config) must name the folder that holds processed/")
     return processed
 
@@ -64,7 +64,7 @@ def _open(url: str):
         return urllib.request.urlopen(request, timeout=_TIMEOUT_S)
     except (TimeoutError, urllib.error.URLError, ConnectionError) as e:
         reason = getattr(e, "reason", e)
-        raise AlfaDataError(f"cannot reach {url} ({reason}). Check the network and run "
+        raise DownloadError(f"cannot reach {url} ({reason}). Check the network and run "
                             f"again, {_BY_HAND}") from e
 
 
@@ -115,7 +115,7 @@ def download_archive(api_url: str, filename: str, dest: Path, md5: str | None = 
 
     Raises
     ------
-    AlfaDataError
+    DownloadError
         If the network cannot be reached, the article has no such file, or the
         download's size, MD5 or SHA-256 differ from what is stated. The message says
         what to do; a file that fails is removed.
@@ -125,7 +125,7 @@ def download_archive(api_url: str, filename: str, dest: Path, md5: str | None = 
     entry = next((f for f in listing if f.get("name") == filename), None)
     if entry is None:
         names = ", ".join(sorted(str(f.get("name")) for f in listing))
-        raise AlfaDataError(f"the archive lists no file {filename!r} (it has: {names}); "
+        raise DownloadError(f"the archive lists no file {filename!r} (it has: {names}); "
                             "set download.file in the config to the processed flights' "
                             "archive")
     size = entry.get("size")
@@ -151,13 +151,13 @@ def download_archive(api_url: str, filename: str, dest: Path, md5: str | None = 
                              size >> 20 if size else "?")
     except (OSError, http.client.HTTPException) as e:
         part.unlink(missing_ok=True)
-        raise AlfaDataError(f"the download of {filename} broke off after {done:,} bytes "
+        raise DownloadError(f"the download of {filename} broke off after {done:,} bytes "
                             f"({e}). Run again, {_BY_HAND}") from e
     got = _digests(part)
     why = _mismatch(filename, got, size, md5s, sha256)
     if why is not None:
         part.unlink()
-        raise AlfaDataError(f"{why} (the partial file was removed), {_BY_HAND}")
+        raise DownloadError(f"{why} (the partial file was removed), {_BY_HAND}")
     part.replace(target)
     log.info("verified %s: %d bytes, md5 %s, sha256 %s", filename, *got)
     return target
@@ -170,7 +170,7 @@ def _members(archive: Path) -> list[str]:
     if tarfile.is_tarfile(archive):
         with tarfile.open(archive) as t:
             return t.getnames()
-    raise AlfaDataError(f"{archive} is neither a zip nor a tar archive; remove it and run "
+    raise DownloadError(f"{archive} is neither a zip nor a tar archive; remove it and run "
                         f"again, {_BY_HAND}")
 
 
@@ -199,7 +199,7 @@ def unpack(archive: Path, dest: Path) -> Path:
     for name in names:
         p = PurePosixPath(name)
         if p.is_absolute() or ".." in p.parts:
-            raise AlfaDataError(f"{archive} holds an unsafe path {name!r}; not unpacked")
+            raise DownloadError(f"{archive} holds an unsafe path {name!r}; not unpacked")
     parts = [PurePosixPath(n).parts for n in names]
     holder = next((q[:q.index("processed")] for q in parts if "processed" in q[:-1]), None)
     staging = dest / ".unpacking"

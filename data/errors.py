@@ -1,12 +1,17 @@
-"""Exceptions raised by the ALFA data layer.
+"""Exceptions raised by the ALFA data layer, one type per kind of trouble.
 
-Every message names the flight, and where they apply the file, the column and the
-line, so that a broken input can be found without a debugger.
+:class:`AlfaDataError` is bad flight data, and only that: a stage turns it into a
+failure row for the flight (and method) and goes on. The others are not a flight's
+fault and stop the run: a signal name no catalogue holds (a config or code error), a
+folder that is not there, a download that failed, a stale cache. Every message names
+the flight, and where they apply the file, the column and the line, so that a broken
+input can be found without a debugger.
 """
 
 from __future__ import annotations
 
-__all__ = ["FAILURE_COLUMNS", "AlfaDataError", "MissingTopicError", "failure_row"]
+__all__ = ["FAILURE_COLUMNS", "AlfaDataError", "DownloadError", "MissingFolderError",
+           "MissingTopicError", "StaleCacheError", "UnknownSignalError", "failure_row"]
 
 #: Columns of a failures table: where a flight was given up, and why.
 FAILURE_COLUMNS = ["flight", "stage", "method", "file", "column", "line", "error"]
@@ -47,6 +52,24 @@ class AlfaDataError(ValueError):
 
 class MissingTopicError(AlfaDataError):
     """A topic a method needs has no CSV file in the flight folder."""
+
+
+class UnknownSignalError(LookupError):
+    """A signal name that :data:`~.signals.SIGNALS` does not hold: a config or code
+    error, never a flight's."""
+
+
+class MissingFolderError(FileNotFoundError):
+    """The folder of the flights (``ALFA_DIR``, ``processed/``) is not there."""
+
+
+class DownloadError(OSError):
+    """The archive could not be fetched, verified or unpacked; the message says what
+    to do."""
+
+
+class StaleCacheError(RuntimeError):
+    """The parsed-flight cache was made from other files than the manifest's."""
 
 
 def failure_row(error: AlfaDataError, stage: str, method: str = "") -> dict:

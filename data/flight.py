@@ -45,7 +45,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .errors import AlfaDataError, MissingTopicError
+from .errors import AlfaDataError, MissingFolderError, MissingTopicError
 
 __all__ = [
     "FAULT_CLASSES",
@@ -270,7 +270,7 @@ def entries(processed: Path) -> list[Path]:
     """Every entry of ``processed`` but hidden ones (``.name``), sorted by name."""
     processed = Path(processed)
     if not processed.is_dir():
-        raise AlfaDataError(f"no such folder: {processed}")
+        raise MissingFolderError(f"no such folder: {processed}")
     return sorted(p for p in processed.iterdir() if not p.name.startswith("."))
 
 

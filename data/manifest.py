@@ -192,7 +192,7 @@ def validate_manifest(manifest: pd.DataFrame) -> None:
 
 
 def read_manifest(path: str | Path) -> pd.DataFrame:
-    """Read ``data/flights.csv`` back with its types, and validate it."""
+    """Read ``results/flights.csv`` back with its types, and validate it."""
     text = {c: str for c in ("date", "time", "subsets", "fault_sensor", "fault_kind",
                              "fault_source", "not_measured")}
     manifest = pd.read_csv(path, dtype=text, keep_default_na=False, na_values={

@@ -51,7 +51,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import AlfaDataError
+from .errors import AlfaDataError, UnknownSignalError
 from .flight import Flight
 
 __all__ = ["COVERAGE_S", "KINDS", "MAX_HOLD_S", "SIGNALS", "Sampled", "Signal", "check_physical",
@@ -192,8 +192,7 @@ class Sampled:
 def series(flight: Flight, name: str) -> tuple[np.ndarray, np.ndarray]:
     """Signal ``name`` of ``flight`` at its topic's record times: ``(t, value)``."""
     if name not in SIGNALS:
-        raise AlfaDataError(f"unknown signal {name!r}; known: {sorted(SIGNALS)}",
-                            flight=flight.id)
+        raise UnknownSignalError(f"unknown signal {name!r}; known: {sorted(SIGNALS)}")
     sig = SIGNALS[name]
     tp = flight.topic(sig.topic)
     value = tp.values(sig.column)
@@ -268,8 +267,7 @@ def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float,
     names = tuple(names)
     unknown = [n for n in names if n not in SIGNALS]
     if unknown:
-        raise AlfaDataError(f"unknown signal(s) {unknown}; known: {sorted(SIGNALS)}",
-                            flight=flight.id)
+        raise UnknownSignalError(f"unknown signal(s) {unknown}; known: {sorted(SIGNALS)}")
     topics = [flight.topic(SIGNALS[n].topic) for n in names]
     for tp in dict.fromkeys(topics):
         _check_coverage(flight, tp)

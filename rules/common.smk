@@ -5,6 +5,7 @@ from pathlib import Path
 from snakemake.exceptions import WorkflowError
 
 from alfa_bench.analysis.provenance import RUN_FILE, module_sources
+from alfa_bench.data import SIGNALS, resolve_alfa_dir
 from alfa_bench.methods import REGISTRY, make_detector
 
 METHODS = list(config["methods"])
@@ -29,6 +30,11 @@ for _name, _spec in config["methods"].items():
         _detector = make_detector(_spec["detector"], _spec.get("params"))
     except (KeyError, TypeError, ValueError) as _e:
         raise WorkflowError(f"config methods.{_name}: {_e}") from None
+    # a misspelt signal is the config's error, not every flight's bad data
+    _unknown = [s for s in _detector.signals() if s not in SIGNALS]
+    if _unknown:
+        raise WorkflowError(f"config methods.{_name}: unknown signal(s) {_unknown}; known: "
+                            f"{sorted(SIGNALS)}")
     if not _detector.causal and _spec.get("role", "method") != "reference":
         raise WorkflowError(f"config methods.{_name}: detector {_spec['detector']!r} is not "
                             "causal, so it can only be a reference row (role: reference)")
@@ -44,14 +50,14 @@ def figure_fault_class(wildcards):
     """The report files each flight's figure under its fault class (from the manifest)."""
     from alfa_bench.data import read_manifest
 
-    manifest = read_manifest("data/flights.csv").set_index("flight")
+    manifest = read_manifest("results/flights.csv").set_index("flight")
     return manifest.at[wildcards.flight, "fault_class"]
 
 
 # ALFA_DIR, else the config's alfa_dir, else the downloaded archive.
-_alfa = os.environ.get("ALFA_DIR") or config.get("alfa_dir")
-DOWNLOAD = not _alfa
-ALFA_DIR = Path(config["download"]["dest"] if DOWNLOAD else _alfa)
+_alfa = resolve_alfa_dir(config.get("alfa_dir"))
+DOWNLOAD = _alfa is None
+ALFA_DIR = Path(config["download"]["dest"]) if DOWNLOAD else _alfa
 PROCESSED = ALFA_DIR / "processed"
 # where the flights came from, in every result's provenance (config is what it records)
 config["alfa_dir"] = str(ALFA_DIR)

@@ -23,8 +23,8 @@ rule manifest:
     input:
         processed=PROCESSED,
     output:
-        manifest="data/flights.csv",
-        failures="data/load_failures.csv",
+        manifest="results/flights.csv",
+        failures="results/load_failures.csv",
         # every flight parsed once: what every later job reads (data/cache.py)
         cache=directory("results/cache"),
     params:

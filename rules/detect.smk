@@ -5,7 +5,7 @@ import json
 # metric and emulation, not of sensors.
 rule detect_reference:
     input:
-        manifest="data/flights.csv",
+        manifest="results/flights.csv",
         cache="results/cache",
         code=lambda w: detector_code(w.method),
     output:
@@ -30,7 +30,7 @@ rule detect_reference:
 # (one fit per fold for both): a changed method re-runs only its own job.
 use rule detect_reference as detect with:
     input:
-        manifest="data/flights.csv",
+        manifest="results/flights.csv",
         cache="results/cache",
         code=lambda w: detector_code(w.method),
         injected="results/injected/flights.csv",

@@ -4,7 +4,7 @@
 
 rule inject:
     input:
-        manifest="data/flights.csv",
+        manifest="results/flights.csv",
         cache="results/cache",
     output:
         manifest="results/injected/flights.csv",
@@ -23,7 +23,7 @@ rule inject:
 # part of `all` (the workflow builds them in memory): `snakemake injected_csv`
 rule injected_csv:
     input:
-        manifest="data/flights.csv",
+        manifest="results/flights.csv",
         processed=PROCESSED,
     output:
         processed=directory(INJECTED_PROCESSED),
@@ -38,7 +38,7 @@ rule injected_csv:
 rule detectability:
     input:
         manifest="results/injected/flights.csv",
-        calibrate_on="data/flights.csv",
+        calibrate_on="results/flights.csv",
         detections=expand("results/injected/detections/{method}", method=DETECTORS),
         clean=expand("results/detections/{method}", method=DETECTORS),
     output:
@@ -57,7 +57,7 @@ rule detectability:
 
 rule isolation:
     input:
-        manifest="data/flights.csv",
+        manifest="results/flights.csv",
         injected="results/injected/flights.csv",
         detections=expand("results/detections/{method}", method=DETECTORS),
         injected_detections=expand("results/injected/detections/{method}",

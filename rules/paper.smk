@@ -18,7 +18,7 @@ PAPER_DIR = Path(workflow.basedir) / "paper"
 rule paper_sources:
     input:
         PAPER_INPUTS,
-        manifest="data/flights.csv",
+        manifest="results/flights.csv",
         comparison="results/tables/comparison.csv",
         by_fault="results/tables/by_fault.csv",
         per_flight="results/tables/per_flight.csv",

@@ -2,7 +2,7 @@
 rule provenance:
     input:
         [f for f in rules.all.input if f != RUN_FILE],
-        manifest="data/flights.csv",
+        manifest="results/flights.csv",
         detections=expand("results/detections/{method}", method=METHODS),
         traces=expand("results/traces/{method}", method=METHODS),
         injected=expand("results/injected/detections/{method}", method=DETECTORS),

@@ -2,7 +2,7 @@ rule rerun_logs:
     # the longest jobs start first, and the short ones fill the other cores
     priority: 2
     input:
-        manifest="data/flights.csv",
+        manifest="results/flights.csv",
         cache="results/cache",
         traces=expand("results/traces/{method}", method=METHODS),
     output:

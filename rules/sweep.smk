@@ -2,7 +2,7 @@ rule sweep:
     # among the jobs ready, first: the paper waits on it
     priority: 2
     input:
-        manifest="data/flights.csv",
+        manifest="results/flights.csv",
         detections=expand("results/detections/{method}", method=METHODS),
         traces=expand("results/traces/{method}", method=METHODS),
     output:
@@ -24,7 +24,7 @@ rule flight_figures:
     # the longest jobs start first, and the short ones fill the other cores
     priority: 2
     input:
-        manifest="data/flights.csv",
+        manifest="results/flights.csv",
         detections=expand("results/detections/{method}", method=METHODS),
         traces=expand("results/traces/{method}", method=METHODS),
     output:

@@ -1,7 +1,7 @@
 rule tables:
     input:
-        manifest="data/flights.csv",
-        load_failures="data/load_failures.csv",
+        manifest="results/flights.csv",
+        load_failures="results/load_failures.csv",
         detections=expand("results/detections/{method}", method=METHODS),
         leakage="results/tables/leakage.csv",
     output:
@@ -31,7 +31,7 @@ rule tables:
 
 rule per_flight:
     input:
-        manifest="data/flights.csv",
+        manifest="results/flights.csv",
         detections=expand("results/detections/{method}", method=METHODS),
         traces=expand("results/traces/{method}", method=METHODS),
     output:
@@ -49,7 +49,7 @@ rule per_flight:
 
 rule runtime:
     input:
-        manifest="data/flights.csv",
+        manifest="results/flights.csv",
         detections=expand("results/detections/{method}", method=METHODS),
         injected=expand("results/injected/detections/{method}", method=DETECTORS),
         benchmarks=expand("results/benchmarks/detect/{method}.tsv", method=METHODS),
@@ -66,7 +66,7 @@ rule runtime:
 
 rule deadline:
     input:
-        manifest="data/flights.csv",
+        manifest="results/flights.csv",
         detections=expand("results/detections/{method}", method=METHODS),
     output:
         csv="results/tables/deadline.csv",
@@ -91,7 +91,7 @@ rule deadline:
 # which signals carry the fault emulation, measured on the flights themselves
 rule leakage:
     input:
-        manifest="data/flights.csv",
+        manifest="results/flights.csv",
         cache="results/cache",
     output:
         csv="results/tables/leakage.csv",

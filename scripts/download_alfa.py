@@ -4,7 +4,7 @@ import logging
 import sys
 
 from alfa_bench.analysis.logs import log_to
-from alfa_bench.data import AlfaDataError, fetch_alfa
+from alfa_bench.data import DownloadError, fetch_alfa
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
@@ -15,7 +15,7 @@ logging.getLogger("alfa_bench.data").addHandler(progress)
 d = sm.params.download
 try:
     fetch_alfa(d["api"], d["file"], d["dest"], d.get("md5"), d.get("sha256"))
-except AlfaDataError as e:
+except DownloadError as e:
     # the details to the log; to the terminal one message, what to do, no traceback
     log = logging.getLogger("alfa_bench.data")
     log.removeHandler(progress)

@@ -1,5 +1,5 @@
-"""Snakemake script: build data/flights.csv from the flights found, and
-data/load_failures.csv from those that cannot be read (strict: stop at the first);
+"""Snakemake script: build results/flights.csv from the flights found, and
+results/load_failures.csv from those that cannot be read (strict: stop at the first);
 write each flight read to the parsed-flight cache."""
 
 import pandas as pd

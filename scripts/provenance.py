@@ -7,5 +7,5 @@ from alfa_bench.data import read_manifest
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 write_run_file(sm.output[0], run_provenance(sm.config, read_manifest(sm.input.manifest)),
-               [*sm.input, "data/load_failures.csv"],
+               [*sm.input, "results/load_failures.csv"],
                unchecked=sm.params.unchecked)

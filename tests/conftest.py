@@ -1,4 +1,3 @@
-import os
 import sys
 from pathlib import Path
 
@@ -6,10 +5,10 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-from alfa_bench.data import build_manifest, load_flight  # noqa: E402
+from alfa_bench.data import build_manifest, load_flight, resolve_alfa_dir  # noqa: E402
 from synthetic import write_corpus, write_flight  # noqa: E402
 
-REAL_ALFA = Path(os.environ["ALFA_DIR"]) if os.environ.get("ALFA_DIR") else None
+REAL_ALFA = resolve_alfa_dir()
 
 
 def pytest_report_header(config):

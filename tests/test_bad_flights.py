@@ -102,3 +102,15 @@ def test_a_record_lists_the_segments_that_calibrated_it(corpus_flights, corpus_m
                 assert 0 <= start < stop and (onset is None or stop < onset - 1.0)
         assert set(record["provenance"]["inputs"]["calibration_sha256"]) == set(cal["flights"])
 
+
+
+def test_a_signal_no_catalogue_holds_stops_the_run_not_one_flight(corpus_flights,
+                                                                  corpus_manifest):
+    from alfa_bench.data import UnknownSignalError
+    spec = {"detector": "rls_arx_zscore",
+            "params": {"pairs": [{"name": "roll", "input": "roll_cmdd", "output": "roll"}]}}
+    failures = []
+    with pytest.raises(UnknownSignalError, match="roll_cmdd"):
+        list(detect_all("typo", spec, corpus_flights, corpus_manifest,
+                        {"group_by": "date", "margin_s": 1.0}, failures))
+    assert failures == []

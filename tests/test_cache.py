@@ -5,7 +5,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from alfa_bench.data import SIGNALS, AlfaDataError, build_manifest, load_flight, read_cached
+from alfa_bench.data import (
+    SIGNALS,
+    AlfaDataError,
+    StaleCacheError,
+    build_manifest,
+    load_flight,
+    read_cached,
+)
 from alfa_bench.data.cache import write_cached
 from alfa_bench.data.inject import (
     KINDS,
@@ -88,7 +95,7 @@ def test_repairs_and_text_columns_survive_the_cache(corpus, tmp_path):
 def test_a_stale_cache_is_refused(corpus, tmp_path):
     flight = load_flight(corpus / SOURCE)
     write_cached(flight, tmp_path / "c.npz", "a" * 64)
-    with pytest.raises(AlfaDataError, match="re-run the manifest rule"):
+    with pytest.raises(StaleCacheError, match="re-run the manifest rule"):
         read_cached(tmp_path / "c.npz", "b" * 64)
 
 

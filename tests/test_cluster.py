@@ -7,6 +7,9 @@ from pathlib import Path
 
 import pytest
 
+# Snakemake or pip in a subprocess, minutes in all: `pytest -m "not workflow"` skips them
+pytestmark = pytest.mark.workflow
+
 REPO = Path(__file__).resolve().parent.parent
 
 
@@ -31,9 +34,9 @@ def test_jobs_run_through_the_generic_cluster_executor(corpus, tmp_path):
     """submit.sh stands in for sbatch: a job is submitted, runs apart, and is seen done."""
     pytest.importorskip("snakemake_executor_plugin_cluster_generic")
     submit = REPO / "profiles/local-cluster/submit.sh"
-    done = snakemake(tmp_path, corpus.parent, "data/flights.csv", "--profile",
+    done = snakemake(tmp_path, corpus.parent, "results/flights.csv", "--profile",
                      str(REPO / "profiles/local-cluster"), "--cluster-generic-submit-cmd",
                      str(submit))
     assert done.returncode == 0, done.stdout + done.stderr
-    assert (tmp_path / "data/flights.csv").exists()
+    assert (tmp_path / "results/flights.csv").exists()
     assert (tmp_path / "results/logs/cluster/snakejob.manifest.0.sh.log").exists()

@@ -48,6 +48,7 @@ def installed(tmp_path_factory):
         [str(site), *filter(None, [os.environ.get("PYTHONPATH")])])}
 
 
+@pytest.mark.workflow
 def test_the_installed_plugin_is_registered_and_passes_the_contract(installed):
     done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
                            str(REPO / "tests/test_contract.py"), "-k", "registry:cusum"],
@@ -57,6 +58,7 @@ def test_the_installed_plugin_is_registered_and_passes_the_contract(installed):
     assert passed >= 10, done.stdout
 
 
+@pytest.mark.workflow
 def test_a_config_run_of_the_plugin_lands_in_the_comparison(installed, corpus, tmp_path):
     extra = tmp_path / "plugin.yaml"
     extra.write_text(yaml.safe_dump({"methods": {"cusum_roll": {"detector": "cusum"}}}))

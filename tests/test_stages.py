@@ -11,7 +11,7 @@ spec.loader.exec_module(stages)
 LOG = """\
 [Thu Nov 26 04:48:13 2026]
 localrule manifest:
-    output: data/flights.csv
+    output: results/flights.csv
     jobid: 2
 [Thu Nov 26 04:48:16 2026]
 Finished jobid: 2 (Rule: manifest)

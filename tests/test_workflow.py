@@ -21,6 +21,9 @@ from alfa_bench.analysis.traces import read_trace
 from alfa_bench.methods import REGISTRY, make_detector
 from synthetic import write_flight
 
+# Snakemake or pip in a subprocess, minutes in all: `pytest -m "not workflow"` skips them
+pytestmark = pytest.mark.workflow
+
 REPO = Path(__file__).resolve().parent.parent
 SNAKEMAKE = [sys.executable, "-m", "snakemake"]
 
@@ -116,7 +119,7 @@ def test_outputs_and_their_contents(runs, corpus):
         assert sorted(ranked["rank"]) == list(range(1, len(ranked) + 1))
         assert list(table["block"]) == sorted(table["block"], key=["honest", "reads actuators",
                                                                    "reference"].index)
-    assert (runs[0] / "data/flights.csv").exists()
+    assert (runs[0] / "results/flights.csv").exists()
 
 
 def test_inspection_outputs_sweeps_figures_and_paper(runs, corpus):
@@ -491,7 +494,7 @@ def test_a_failed_download_ends_on_what_to_do_without_a_traceback(tmp_path):
         "api": f"http://127.0.0.1:{port}/files", "file": "processed.zip",
         "md5": "0" * 32, "sha256": None, "dest": "resources/alfa"}}))
     done = run_workflow(tmp_path, None, "--configfile", str(REPO / "config/config.yaml"),
-                        str(config), target="data/flights.csv", ok=False)
+                        str(config), target="results/flights.csv", ok=False)
     assert done.stderr.count("download_alfa: cannot reach") == 1, done.stderr
     assert "Traceback" not in done.stderr and "set ALFA_DIR" in done.stderr, done.stderr
     log = (tmp_path / "results/logs/download_alfa.log").read_text()
@@ -506,7 +509,7 @@ def test_every_csv_reads_plainly_with_its_documented_header(runs):
     documented = dict(re.findall(r"^- `([^`]+\.csv)`: (.+)$", (REPO / "docs/outputs.md")
                                  .read_text(), flags=re.M))
     work = runs[0]
-    found = sorted(p for p in [*(work / "results").rglob("*.csv"), *(work / "data").glob("*.csv")]
+    found = sorted(p for p in (work / "results").rglob("*.csv")
                    if "detections" not in p.parts)
     assert {p.relative_to(work).as_posix() for p in found} == set(documented)
     for path in found:
@@ -518,7 +521,7 @@ def test_every_csv_reads_plainly_with_its_documented_header(runs):
             assert table.columns == header and len(table.fetchall()) == len(frame), path
     for path in (work / "results/detections").glob("*/failures.csv"):
         assert list(pd.read_csv(path).columns) == re.findall(
-            r"`([^`]+)`", documented["data/load_failures.csv"])[:-1], path
+            r"`([^`]+)`", documented["results/load_failures.csv"])[:-1], path
 
 
 @pytest.fixture(scope="module")
@@ -595,3 +598,15 @@ def test_a_damaged_flight_moves_no_clean_flight_but_through_calibration(damaged,
             assert not used & refused, (method, flight)
             if before["first_alarm_s"] != after["first_alarm_s"]:
                 assert used & damaged_flights, (method, flight)
+
+
+def test_a_misspelt_signal_in_a_config_run_stops_the_dry_run(corpus, tmp_path):
+    """A typo is the config's error: it stops `snakemake -n` naming the run, instead of
+    excluding every flight as bad data."""
+    config = tmp_path / "typo.yaml"
+    config.write_text(yaml.safe_dump({"methods": {"typo": {
+        "detector": "rls_arx_zscore",
+        "params": {"pairs": [{"name": "roll", "input": "roll_cmdd", "output": "roll"}]}}}}))
+    done = run_workflow(tmp_path, corpus.parent, "-n", "--configfile",
+                        str(REPO / "config/config.yaml"), str(config), ok=False)
+    assert "config methods.typo: unknown signal(s) ['roll_cmdd']" in done.stdout + done.stderr
