@@ -50,7 +50,7 @@ from alfa_bench.data import SIGNALS
 
 from .reference import ICRA2019_SUMMARY
 from .render import latex_escape
-from .tables import FAULT_ORDER
+from .tables import FAULT_ORDER, SIGNIFICANCE
 
 __all__ = ["latex_macros", "latex_keys", "paper_numbers", "render_markdown", "sensor_numbers"]
 
@@ -114,7 +114,7 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.Dat
                                     if len(best) else "n/a")
         out[f"bestfalsealarms:{s}"] = (out[f"falsealarms:{best['method'].iloc[0]}:{s}"]
                                        if len(best) else "n/a")
-        tied = table[(table["vs_best_p"] >= 0.05) & (table["block"] == "honest")]
+        tied = table[(table["vs_best_p"] >= SIGNIFICANCE) & (table["block"] == "honest")]
         out[f"tied:{s}"] = ", ".join(tied["method"]) or "none"
     for (m, s), table in sweep.groupby(["method", "subset"], sort=False):
         clean = table[table["fp"] == 0]

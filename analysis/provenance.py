@@ -247,9 +247,12 @@ def read_provenance(path: str | Path) -> dict:
                 return json.loads(str(z["provenance"][0]))
         case ".json":
             return json.loads(path.read_text())["provenance"]
-        case ".rrd":
-            from .rerun_log import read_rerun_provenance
-            return read_rerun_provenance(path)
+        case ".rrd":       # the recording's property (rerun_log.write_rerun_log)
+            import rerun.chunk as rc
+            for chunk in rc.RrdReader(path).store().stream().to_chunks():
+                if chunk.entity_path == "/__properties/provenance":
+                    return json.loads(chunk.to_record_batch().column("json").to_pylist()[0][0])
+            raise ValueError(f"{path} carries no provenance property")
     raise ValueError(f"no provenance is recorded in {path}")
 
 

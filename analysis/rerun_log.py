@@ -21,7 +21,7 @@ Entities
     Fault onset and end, and the start of every alarm of every method.
 Recording properties: ``flight`` (fault class, onset, end, date, label and the
 code version that wrote the file) and ``provenance`` (the run's provenance as JSON,
-:func:`read_rerun_provenance`).
+:func:`~.provenance.read_provenance` reads it back).
 """
 
 from __future__ import annotations
@@ -33,7 +33,6 @@ from pathlib import Path
 import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
-import rerun.chunk as rc
 
 from alfa_bench.data import SIGNALS, AlfaDataError, Flight, series
 from alfa_bench.methods import Trace
@@ -41,7 +40,7 @@ from alfa_bench.methods import Trace
 from .provenance import code_version
 from .sweep import ratio
 
-__all__ = ["TIMELINE", "blueprint", "read_rerun_provenance", "signal_group", "write_rerun_log"]
+__all__ = ["TIMELINE", "blueprint", "signal_group", "write_rerun_log"]
 
 log = logging.getLogger(__name__)
 
@@ -184,11 +183,3 @@ def write_rerun_log(flight: Flight, traces: dict[str, Trace], signals: list[str]
                          columns=rr.TextLog.columns(text=list(texts), level=list(levels)))
     rec.flush()
     rec.disconnect()
-
-
-def read_rerun_provenance(path: str | Path) -> dict:
-    """The provenance a recording written by :func:`write_rerun_log` carries."""
-    for chunk in rc.RrdReader(path).store().stream().to_chunks():
-        if chunk.entity_path == "/__properties/provenance":
-            return json.loads(chunk.to_record_batch().column("json").to_pylist()[0][0])
-    raise ValueError(f"{path} carries no provenance property")

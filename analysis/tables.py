@@ -31,19 +31,20 @@ import math
 
 import pandas as pd
 
-from alfa_bench.data import FAILURE_COLUMNS, subset_flights
+from alfa_bench.data import FAILURE_COLUMNS, FAULT_CLASSES, subset_flights
 
 from .isolation import names_class
 from .reference import ICRA2019_BY_FAULT, ICRA2019_NAME, ICRA2019_SUMMARY
 from .render import Section, fmt, latex_tables, markdown
 from .scoring import mcnemar_exact, score_records
 
-__all__ = ["BLOCKS", "BLOCK_MARKS", "FAULT_ORDER", "block", "by_fault_latex",
+__all__ = ["BLOCKS", "BLOCK_MARKS", "FAULT_ORDER", "SIGNIFICANCE", "block", "by_fault_latex",
            "by_fault_markdown", "by_fault_table", "comparison_latex", "comparison_markdown",
            "comparison_notes", "comparison_table", "failures_table", "summary_latex",
            "summary_markdown", "summary_table", "unscored_notes"]
 
-FAULT_ORDER = ("engine", "rudder", "elevator", "aileron", "rudder+aileron", "none")
+#: ALFA's fault classes in the tables' order (the injected sensor faults are scored apart)
+FAULT_ORDER = tuple(c for c in FAULT_CLASSES if c != "sensor")
 
 #: the blocks of runs, in the order the tables list them
 BLOCKS = ("honest", "reads actuators", "reference")
@@ -51,7 +52,8 @@ BLOCKS = ("honest", "reads actuators", "reference")
 BLOCK_MARKS = {"honest": "", "reads actuators": " (MARKED: reads actuators)",
                "reference": " (reference)"}
 
-_SIGNIFICANCE = 0.05
+#: the level below which the exact McNemar test tells two runs apart
+SIGNIFICANCE = 0.05
 
 
 def block(record: dict) -> str:
@@ -345,7 +347,7 @@ def _comparison_sections(comparison: pd.DataFrame, primary: str | None = None
             p = r.get("vs_best_p")
             paired = ("best" if r.get("rank") == 1 else "-" if fmt(p) == "-" else
                       f"{int(r['vs_best_only_this'])} / {int(r['vs_best_only_best'])}, "
-                      f"p = {p:.3f}" + ("" if p < _SIGNIFICANCE else " (cannot tell apart)"))
+                      f"p = {p:.3f}" + ("" if p < SIGNIFICANCE else " (cannot tell apart)"))
             rank = r.get("rank")
             why = r.get("not_ranked")
             return [why if isinstance(why, str) and why else
@@ -389,11 +391,11 @@ def comparison_notes(comparison: pd.DataFrame) -> str:
         if not len(best):
             lines.append(f"- `{subset}`: no honest method.")
             continue
-        same = table.loc[(table["vs_best_p"] >= _SIGNIFICANCE) & (table["method"] !=
+        same = table.loc[(table["vs_best_p"] >= SIGNIFICANCE) & (table["method"] !=
                          best.iloc[0]), "method"]
         names = ", ".join(f"`{m}`" for m in same) or "none"
         lines.append(f"- `{subset}`: the best honest method is `{best.iloc[0]}`; the data "
-                     f"cannot tell it apart (McNemar p ≥ {_SIGNIFICANCE}) from: {names}.")
+                     f"cannot tell it apart (McNemar p ≥ {SIGNIFICANCE}) from: {names}.")
     return "\n".join(lines) + "\n"
 
 

@@ -17,6 +17,7 @@ from .base import (
     Detector,
     Labelled,
     NotFittedError,
+    PairDetector,
     Trace,
     fault_free_segments,
     labelled_segments,
@@ -25,7 +26,7 @@ from .base import (
 )
 
 __all__ = ["BUILTIN", "BUILTIN_ENTRIES", "PLUGIN_GROUP", "REGISTRY", "Detector", "Labelled",
-           "NotFittedError", "Trace", "fault_free_segments", "labelled_segments",
+           "NotFittedError", "PairDetector", "Trace", "fault_free_segments", "labelled_segments",
            "make_detector", "plugins", "run_detector", "skipped_channels"]
 
 #: the entry-point group third-party detectors register under
@@ -74,6 +75,8 @@ def __getattr__(name: str):
     """``BUILTIN``: the detectors that ship with alfa-bench; ``REGISTRY``: every detector
     a config run can name, the built-in ones and the installed plugins. Each is built
     once, on first use."""
+    if name in globals():
+        return globals()[name]
     if name == "BUILTIN":
         globals()["BUILTIN"] = _builtin()
     elif name == "REGISTRY":

@@ -40,8 +40,8 @@ import numpy as np
 
 from alfa_bench.data import Flight, Sampled, not_measured, sample
 
-__all__ = ["Detector", "Labelled", "NotFittedError", "Trace", "fault_free_segments",
-           "labelled_segments", "run_detector", "skipped_channels"]
+__all__ = ["Detector", "Labelled", "NotFittedError", "PairDetector", "Trace",
+           "fault_free_segments", "labelled_segments", "run_detector", "skipped_channels"]
 
 log = logging.getLogger(__name__)
 
@@ -151,6 +151,24 @@ class Detector(ABC):
             Per channel; NaN while the channel is not yet armed.
         alarm : ndarray of bool, shape (c,)
         """
+
+
+class PairDetector(Detector):
+    """A detector with one score channel per input/output pair of ``self.pairs``
+    (``{"name", "input", "output"}``): the channel is named for the pair and scores its
+    output."""
+
+    pairs: tuple
+
+    def signals(self) -> tuple[str, ...]:
+        """The pairs' signals, each once, in order of first use."""
+        return tuple(dict.fromkeys(s for p in self.pairs for s in (p["input"], p["output"])))
+
+    def channels(self) -> tuple[str, ...]:
+        return tuple(p["name"] for p in self.pairs)
+
+    def channel_outputs(self) -> tuple[str, ...]:
+        return tuple(p["output"] for p in self.pairs)
 
 
 @dataclass(frozen=True)

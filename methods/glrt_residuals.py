@@ -39,8 +39,9 @@ from alfa_bench.data import Sampled
 
 from . import kernels
 from .arx import ArxRegressor, arx_regressors, fit_arx
+from .base import PairDetector
 from .glrt import chi2_threshold, empirical_threshold, glrt_statistic
-from .rls_arx_zscore import DEFAULT_PAIRS, PairDetector, RlsArxZscore
+from .rls_arx_zscore import DEFAULT_PAIRS, RlsArxZscore
 
 __all__ = ["GlrtResiduals"]
 

@@ -67,9 +67,9 @@ import numpy as np
 from alfa_bench.data import Sampled
 
 from . import kernels
-from .base import Detector
+from .base import PairDetector
 
-__all__ = ["DEFAULT_PAIRS", "PairDetector", "RlsArxZscore"]
+__all__ = ["DEFAULT_PAIRS", "RlsArxZscore"]
 
 DEFAULT_PAIRS = (
     {"name": "roll", "input": "roll_cmd", "output": "roll"},
@@ -79,24 +79,6 @@ DEFAULT_PAIRS = (
 )
 
 _REPEATED = ("hold", "fresh")
-
-
-class PairDetector(Detector):
-    """A detector with one score channel per input/output pair of ``self.pairs``
-    (``{"name", "input", "output"}``): the channel is named for the pair and scores its
-    output."""
-
-    pairs: tuple
-
-    def signals(self) -> tuple[str, ...]:
-        """The pairs' signals, each once, in order of first use."""
-        return tuple(dict.fromkeys(s for p in self.pairs for s in (p["input"], p["output"])))
-
-    def channels(self) -> tuple[str, ...]:
-        return tuple(p["name"] for p in self.pairs)
-
-    def channel_outputs(self) -> tuple[str, ...]:
-        return tuple(p["output"] for p in self.pairs)
 
 
 class _Pair:

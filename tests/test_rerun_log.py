@@ -6,10 +6,10 @@ import rerun.blueprint as rrb
 import rerun.chunk as rc
 from recordings import content
 
+from alfa_bench.analysis.provenance import read_provenance
 from alfa_bench.analysis.rerun_log import (
     TIMELINE,
     blueprint,
-    read_rerun_provenance,
     write_rerun_log,
 )
 from alfa_bench.data import load_flight, series
@@ -73,7 +73,7 @@ def test_the_same_run_writes_the_same_content(recording):
 
 def test_the_recording_carries_its_provenance(recording):
     _, _, (path, _) = recording
-    assert read_rerun_provenance(path) == {"inputs": {"a": "0" * 64}}
+    assert read_provenance(path) == {"inputs": {"a": "0" * 64}}
 
 
 def test_the_viewer_opens_paused_on_the_fault_with_the_whole_flight_in_view():
