@@ -41,6 +41,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 from reference_rls_arx import PlainRecursiveLeastSquares, PlainRlsArxZscore  # noqa: E402
 
 from alfa_bench.data import Sampled, load_flight, sample  # noqa: E402
+from alfa_bench.data.synthetic import write_corpus  # noqa: E402
 from alfa_bench.methods import (  # noqa: E402
     Detector,
     fault_free_segments,
@@ -50,7 +51,6 @@ from alfa_bench.methods.glrt import WindowedGlrt  # noqa: E402
 from alfa_bench.methods.kernels import glrt_advance, kalman_innovations  # noqa: E402
 from alfa_bench.methods.rls import RecursiveLeastSquares  # noqa: E402
 from alfa_bench.methods.rls_arx_zscore import RlsArxZscore  # noqa: E402
-from synthetic import write_corpus  # noqa: E402
 
 PAIR = [{"name": "roll", "input": "roll_cmd", "output": "roll"}]
 NA, NB = 1, 25

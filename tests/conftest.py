@@ -6,7 +6,7 @@ import pytest
 sys.path.insert(0, str(Path(__file__).parent))
 
 from alfa_bench.data import build_manifest, load_flight, resolve_alfa_dir  # noqa: E402
-from synthetic import write_corpus, write_flight  # noqa: E402
+from alfa_bench.data.synthetic import write_corpus, write_flight  # noqa: E402
 
 REAL_ALFA = resolve_alfa_dir()
 

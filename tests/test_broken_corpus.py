@@ -10,7 +10,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from alfa_bench.data import AlfaDataError
-from synthetic import write_flight
+from alfa_bench.data.synthetic import write_flight
 
 
 @pytest.fixture(scope="module")

@@ -8,8 +8,8 @@ import pytest
 
 from alfa_bench.data import AlfaDataError, build_manifest, load_flight, not_measured
 from alfa_bench.data.inject import inject_grid, inject_sensor_fault
+from alfa_bench.data.synthetic import write_flight
 from alfa_bench.methods import fault_free_segments, make_detector, run_detector
-from synthetic import write_flight
 
 FREE = "carbonZ_2018-09-11-14-16-55_no_failure"
 BANK = {"inputs": ["roll_cmd", "pitch_cmd"], "outputs": ["roll", "airspeed"]}

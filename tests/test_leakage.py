@@ -14,7 +14,7 @@ from alfa_bench.analysis.leakage import (
 )
 from alfa_bench.data import load_flight
 from alfa_bench.data.manifest import manifest_of, manifest_row
-from synthetic import write_flight
+from alfa_bench.data.synthetic import write_flight
 
 FLIGHTS = {
     "carbonZ_2018-07-18-15-53-31_1_engine_failure": dict(onset_s=50.0),

@@ -5,7 +5,7 @@ import pytest
 
 from alfa_bench.data import AlfaDataError, MissingTopicError, find_flights, load_flight
 from alfa_bench.data.flight import parse_flight_name
-from synthetic import rename_flight
+from alfa_bench.data.synthetic import rename_flight
 
 
 def test_clock_onset_class_and_label(one_flight):
@@ -69,7 +69,7 @@ def test_bad_folder_name_is_an_error(tmp_path):
 
 
 def test_no_ground_truth_flight_is_kept_out_of_scoring(tmp_path, caplog):
-    from synthetic import write_flight
+    from alfa_bench.data.synthetic import write_flight
     f = load_flight(write_flight(tmp_path, "carbonZ_2018-07-18-12-10-11_no_ground_truth"))
     assert f.fault is None and not f.has_ground_truth
     assert "kept out of labelled scoring" in caplog.text

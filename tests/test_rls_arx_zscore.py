@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
+from alfa_bench.data.synthetic import arx_response, command
 from alfa_bench.methods import make_detector
-from synthetic import arx_response, command
 
 RATE = 25.0
 PAIR = ({"name": "roll", "input": "roll_cmd", "output": "roll"},)

@@ -18,8 +18,8 @@ from recordings import content
 
 from alfa_bench.analysis.provenance import RUN_FILE, read_provenance, read_table
 from alfa_bench.analysis.traces import read_trace
+from alfa_bench.data.synthetic import write_flight
 from alfa_bench.methods import REGISTRY, make_detector
-from synthetic import write_flight
 
 # Snakemake or pip in a subprocess, minutes in all: `pytest -m "not workflow"` skips them
 pytestmark = pytest.mark.workflow

@@ -1,0 +1,10 @@
+"""The plugin checks itself against alfa-bench's detector contract."""
+
+from alfa_cusum import Cusum
+
+from alfa_bench.methods.checks import parametrize_with_checks
+
+
+@parametrize_with_checks([Cusum(), Cusum(signal="pitch_error", margin=1.5)])
+def test_cusum(detector, check):
+    check(detector)

@@ -1,0 +1,248 @@
+"""The detector contract, as checks any detector can be run through, in or out of the
+package (scikit-learn's ``check_estimator`` and ``parametrize_with_checks`` are the
+model).
+
+Each check takes an unfitted detector, copies it, fits the copy where it is calibrated
+(on the fault-free data of a small synthetic corpus, :mod:`alfa_bench.data.synthetic`)
+and raises ``AssertionError`` where the contract fails:
+
+- the constructor stores its hyper-parameters and nothing else; learned state ends
+  in ``_``; a calibrated detector refuses to run unfitted;
+- fitted values are JSON-ready, outputs have the declared shape, each channel names
+  the measured signal it scores, and a channel alarms exactly when its score is above
+  its threshold (so stored scores can be re-thresholded);
+- probes are named once and change nothing; a batch ``run`` equals stepping
+  ``update`` (scores to rounding, the same alarms); runs are deterministic, and
+  ``reset`` forgets the previous flight;
+- it is causal: changing the data after time *t* changes no output before *t*.
+
+A plugin's own tests run them all with one decorator::
+
+    from alfa_bench.methods.checks import parametrize_with_checks
+
+    @parametrize_with_checks([Cusum()])
+    def test_cusum(detector, check):
+        check(detector)
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import shutil
+import tempfile
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+
+from alfa_bench.data import SIGNALS, load_flight, sample
+from alfa_bench.data.synthetic import write_corpus
+
+from .base import Detector, NotFittedError, fault_free_segments, run_detector
+
+__all__ = ["CHECKS", "parametrize_with_checks"]
+
+#: the corpus flight the checks run a detector on
+_FLIGHT = "carbonZ_2018-07-18-15-53-31_1_engine_failure"
+
+
+@cache
+def _corpus() -> Path:
+    """The synthetic corpus, written once per process to a folder of its own."""
+    processed = Path(tempfile.mkdtemp(prefix="alfa-bench-checks-")) / "processed"
+    write_corpus(processed)
+    return processed
+
+
+def _fit(detector: Detector) -> Detector:
+    training = [load_flight(p) for p in sorted(_corpus().iterdir())]
+    return detector.fit(fault_free_segments(detector, training, margin_s=1.0))
+
+
+_FITTED: dict = {}
+
+
+def _fitted(detector: Detector) -> Detector:
+    """A fitted copy of ``detector`` that has never run (fits are kept per process)."""
+    key = (type(detector), repr(detector.get_params()))
+    if key not in _FITTED:
+        _FITTED[key] = _fit(copy.deepcopy(detector))
+    return copy.deepcopy(_FITTED[key])
+
+
+def _flight():
+    return load_flight(_corpus() / _FLIGHT)
+
+
+def _skip(reason: str):
+    import pytest  # the checks run under pytest (parametrize_with_checks)
+
+    pytest.skip(reason)
+
+
+def _assert_same(a, b, upto=None):
+    sl = slice(None) if upto is None else slice(0, upto)
+    np.testing.assert_array_equal(a.t[sl], b.t[sl])
+    np.testing.assert_array_equal(a.score[sl], b.score[sl])  # NaN == NaN here
+    np.testing.assert_array_equal(a.alarm[sl], b.alarm[sl])
+
+
+def check_constructor_stores_hyper_parameters_only(detector: Detector) -> None:
+    d = copy.deepcopy(detector)
+    assert set(vars(d)) == set(d.get_params())
+    before = set(vars(d))
+    _fit(d).reset()
+    learned = set(vars(d)) - before
+    assert learned and all(a.endswith("_") for a in learned)
+
+
+def check_calibrated_detectors_refuse_to_run_unfitted(detector: Detector) -> None:
+    d = copy.deepcopy(detector)
+    if not d.calibrated:
+        assert d.fitted() == {}
+        return
+    try:
+        run_detector(d, _flight())
+    except NotFittedError as e:
+        assert "fit" in str(e)
+    else:
+        raise AssertionError("a calibrated detector ran before fit()")
+
+
+def check_fitted_values_are_json_ready(detector: Detector) -> None:
+    json.dumps(_fitted(detector).fitted(), allow_nan=False)
+
+
+def check_outputs_have_the_declared_shape(detector: Detector) -> None:
+    d = _fitted(detector)
+    trace = run_detector(d, _flight())
+    assert trace.score.shape == trace.alarm.shape == (trace.t.size, len(d.channels()))
+    assert trace.alarm.dtype == bool
+    assert np.all(np.diff(trace.t) > 0)
+
+
+def check_each_channel_names_the_measured_signal_it_scores(detector: Detector) -> None:
+    outputs = detector.channel_outputs()
+    assert len(outputs) == len(detector.channels())
+    assert set(outputs) <= set(detector.signals()) and set(outputs) <= set(SIGNALS)
+
+
+def check_alarm_is_score_above_threshold(detector: Detector) -> None:
+    d = _fitted(detector)
+    trace = run_detector(d, _flight())
+    assert trace.threshold.shape == (len(d.channels()),)
+    assert np.all(trace.threshold > 0)
+    with np.errstate(invalid="ignore"):
+        np.testing.assert_array_equal(trace.alarm, trace.score > trace.threshold)
+
+
+def check_probes_are_named_once_and_do_not_change_the_run(detector: Detector) -> None:
+    d, flight = _fitted(detector), _flight()
+    plain, probed = run_detector(d, flight), run_detector(d, flight, probes=True)
+    _assert_same(plain, probed)
+    assert plain.probes == {}
+    assert len(probed.probes) == len(set(probed.probes))
+    for name, values in probed.probes.items():
+        assert values.shape == probed.t.shape
+        assert np.isfinite(values).any(), f"probe {name} is never computed"
+
+
+def check_batch_run_equals_streaming(detector: Detector) -> None:
+    """A detector's own run() (batch or compiled) gives the scores and probes of update()
+    step by step to rounding, and the same alarms wherever a score is not within
+    rounding of its threshold. (A non-causal reference's run() uses the whole flight
+    by design: skipped.)"""
+    d = _fitted(detector)
+    if not d.causal:
+        _skip("a non-causal reference: its run() uses the whole flight by design")
+    s = sample(_flight(), d.signals(), d.rate_hz)
+    score, alarm, probes = d.run(s, probes=True)
+    ref_score, ref_alarm, ref_probes = Detector.run(d, s, probes=True)
+    np.testing.assert_allclose(score, ref_score, rtol=1e-9, atol=1e-9)
+    thr = d.thresholds()
+    tie = np.abs(ref_score - thr) <= 1e-9 * np.maximum(1.0, thr)
+    np.testing.assert_array_equal(alarm[~tie], ref_alarm[~tie])
+    assert list(probes) == list(ref_probes)
+    for name in probes:
+        np.testing.assert_allclose(probes[name], ref_probes[name], rtol=1e-9, atol=1e-9)
+
+
+def check_deterministic(detector: Detector) -> None:
+    d, flight = _fitted(detector), _flight()
+    _assert_same(run_detector(d, flight), run_detector(d, flight))
+
+
+def check_reset_forgets_the_previous_flight(detector: Detector) -> None:
+    d = _fitted(detector)
+    other = load_flight(next(p for p in sorted(_corpus().iterdir()) if "no_failure" in p.name))
+    run_detector(d, other)
+    fresh = _fit(type(d)(**d.get_params()))
+    assert fresh.fitted() == d.fitted()
+    _assert_same(run_detector(d, _flight()), run_detector(fresh, _flight()))
+
+
+def _scrambled(cell: str) -> str:
+    try:
+        return repr(float(cell) * -3.0 + 17.0)
+    except ValueError:
+        return cell
+
+
+def check_causal(detector: Detector) -> None:
+    """Changing the data after time t changes no output before t (a detector that
+    declares itself non-causal, a reference row, is skipped)."""
+    d = _fitted(detector)
+    if not d.causal:
+        _skip("a non-causal reference, ranked apart")
+    flight = _flight()
+    base = run_detector(d, flight)
+    cut_s = 0.7 * float(base.t[-1])
+    with tempfile.TemporaryDirectory() as tmp:
+        altered = shutil.copytree(_corpus() / _FLIGHT, Path(tmp) / _FLIGHT)
+        for f in altered.glob("*mavros*.csv"):
+            lines = f.read_text().splitlines()
+            cut_ns = flight.t0_ns + int(cut_s * 1e9)
+            out = [lines[0]]
+            for line in lines[1:]:
+                if int(line.split(",", 1)[0]) > cut_ns:
+                    cells = line.split(",")   # every field after the cut, not time, seq, stamp
+                    line = ",".join(cells[:3] + [_scrambled(c) for c in cells[3:]])
+                out.append(line)
+            f.write_text("\n".join(out) + "\n")
+        changed = run_detector(d, load_flight(altered))
+    before = int(np.searchsorted(base.t, cut_s, side="right"))
+    assert before > 0
+    _assert_same(base, changed, upto=before)
+    # the alteration must reach the detector, or this check could not fail
+    assert not np.array_equal(base.score[before:], changed.score[before:], equal_nan=True)
+
+
+#: every check, in the order they run
+CHECKS = (
+    check_constructor_stores_hyper_parameters_only,
+    check_calibrated_detectors_refuse_to_run_unfitted,
+    check_fitted_values_are_json_ready,
+    check_outputs_have_the_declared_shape,
+    check_each_channel_names_the_measured_signal_it_scores,
+    check_alarm_is_score_above_threshold,
+    check_probes_are_named_once_and_do_not_change_the_run,
+    check_batch_run_equals_streaming,
+    check_deterministic,
+    check_reset_forgets_the_previous_flight,
+    check_causal,
+)
+
+
+def parametrize_with_checks(detectors):
+    """A pytest decorator running every check of :data:`CHECKS` on every detector of
+    ``detectors`` (unfitted instances; a dict gives them ids), as test parameters
+    ``detector`` and ``check``."""
+    import pytest
+
+    named = detectors if isinstance(detectors, dict) else {
+        f"{type(d).__name__}{i}" if len(detectors) > 1 else type(d).__name__: d
+        for i, d in enumerate(detectors)}
+    cases = [(d, c) for d in named.values() for c in CHECKS]
+    ids = [f"{name}-{c.__name__.removeprefix('check_')}" for name in named for c in CHECKS]
+    return pytest.mark.parametrize("detector, check", cases, ids=ids)
