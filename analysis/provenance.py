@@ -15,9 +15,7 @@ records, Parquet tables, recordings. :func:`read_provenance` reads either kind.
 
 from __future__ import annotations
 
-import ast
 import hashlib
-import importlib
 import json
 import struct
 import subprocess
@@ -31,9 +29,8 @@ import pandas as pd
 
 from .calibration import folds
 
-__all__ = ["PACKAGES", "RUN_FILE", "code_version", "file_sha256", "module_sources",
-           "package_versions", "provenance", "read_provenance", "read_table", "run_id",
-           "run_provenance", "stamp", "write_run_file"]
+__all__ = ["PACKAGES", "RUN_FILE", "code_version", "file_sha256", "package_versions", "provenance",
+           "read_provenance", "read_table", "run_id", "run_provenance", "stamp", "write_run_file"]
 
 #: where the run's provenance and every output's checksum are written
 RUN_FILE = "results/provenance.json"
@@ -57,49 +54,6 @@ def code_version() -> dict:
     commit = git("rev-parse", "HEAD")
     dirty = bool(git("status", "--porcelain", "--untracked-files=no")) if commit else None
     return {"version": metadata.version("alfa-bench"), "git_commit": commit, "git_dirty": dirty}
-
-
-def module_sources(cls: type) -> list[str]:
-    """The source files of the module defining ``cls`` and of every ``alfa_bench`` module
-    it imports, transitively: the code a job that runs ``cls`` depends on. A workflow
-    rule takes them as inputs, so that a changed module re-runs exactly the jobs of the
-    detectors that use it. (``from . import x`` names the submodule ``x`` only, not its
-    package: a detector added to the package's registry is no change to the others.)"""
-    found: dict[str, str] = {}
-    todo = [cls.__module__]
-    while todo:
-        name = todo.pop()
-        if name not in found:
-            found[name], imports = _imports(name)
-            todo += imports
-    return sorted(found.values())
-
-
-@cache
-def _imports(name: str) -> tuple[str, list[str]]:
-    """The source file of module ``name`` and the ``alfa_bench`` modules it imports.
-    Cached: the workflow asks once per method, and most share their modules."""
-    module = importlib.import_module(name)
-    found = []
-    for node in ast.walk(ast.parse(Path(module.__file__).read_text())):
-        if isinstance(node, ast.Import):
-            found += [a.name for a in node.names if a.name.startswith("alfa_bench")]
-        elif isinstance(node, ast.ImportFrom):
-            base = ("." * node.level + (node.module or "")) if node.level else node.module
-            base = importlib.util.resolve_name(base, module.__package__)
-            if not base.startswith("alfa_bench"):
-                continue
-            names = [] if node.module is None else [base]
-            found += [m for m in (*names, *(f"{base}.{a.name}" for a in node.names))
-                      if m == base or _is_module(m)]
-    return module.__file__, found
-
-
-def _is_module(name: str) -> bool:
-    try:
-        return importlib.util.find_spec(name) is not None
-    except ModuleNotFoundError:
-        return False
 
 
 @cache
