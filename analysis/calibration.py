@@ -61,8 +61,8 @@ class HeldOutError(RuntimeError):
 def check_held_out(segments, fold: str, scored: list[str], group: dict[str, str]) -> None:
     """Raise :class:`HeldOutError` if a segment (anything with a ``flight``) comes from
     a flight of ``scored`` or of group ``fold`` (``group`` maps flights to groups)."""
-    seen = {seg.flight for seg in segments}
-    inside = sorted(f for f in seen if f in set(scored) or group.get(f) == fold)
+    seen, scored = {seg.flight for seg in segments}, set(scored)
+    inside = sorted(f for f in seen if f in scored or group.get(f) == fold)
     unknown = sorted(seen - set(group))
     if inside or unknown:
         what = (f"flights of the scored group: {inside}" if inside else

@@ -37,15 +37,17 @@ it when that holds. What that means depends on the signal's kind:
 
 - a signal that goes flat carries the emulation, whatever its kind (a sensor that
   did would contradict its kind);
-- a ``setpoint`` or ``actuator`` that steps carries the label: a real fault reaches
-  the commands only through the aircraft. The step of a setpoint is taken on its
-  command: for an error against a command (``roll_error``, measured minus commanded)
-  the command it subtracts, since its measured part is a sensor's;
+- a ``setpoint`` that steps carries the label: a real fault reaches the outer loop's
+  commands only through the aircraft, over seconds. The step of a setpoint is taken
+  on its command: for an error against a command (``roll_error``, measured minus
+  commanded) the command it subtracts, since its measured part is a sensor's;
 - a ``sensor`` that steps measures the aircraft's response: the signature a detector
   is there to find, or on an emergency-trajectory flight the manoeuvre the new
-  commands cause. It is shown, not counted as a leak.
+  commands cause. An ``actuator`` that steps may be the inner loop answering the
+  aircraft within the window as well as the emulation; the flat test is its evidence.
+  Both are shown, not counted as leaks.
 
-So ``leaks`` = goes flat, or steps and is not a sensor. A group of flights on which a
+So ``leaks`` = goes flat, or steps and is a setpoint. A group of flights on which a
 sensor or setpoint leaks is one on which an honest method can read the label; the
 primary subset must hold none (:func:`leaking_flights`).
 
@@ -72,6 +74,10 @@ from .tables import FAULT_ORDER
 
 __all__ = ["StepTest", "audit_note", "flat_spell_starts", "leaking_flights", "leakage_markdown",
            "leakage_table", "step_ranks", "step_sizes"]
+
+
+#: fault classes in the tables' order, for sorting the audit's groups
+_ORDER = {c: i for i, c in enumerate(FAULT_ORDER)}
 
 
 @dataclass(frozen=True)
@@ -218,8 +224,7 @@ def leakage_table(flights: dict[str, Flight], flat_s: float = 1.0, before_s: flo
                           *_step_events(tau, d, onset, margin_s, step)))
         flat_free = free[0] / free[1] if free[1] else math.nan
         step_free = free[2] / free[3] if free[3] else math.nan
-        order = {c: i for i, c in enumerate(FAULT_ORDER)}
-        for (fault_class, emr) in sorted(groups, key=lambda g: (order.get(g[0], 99), g[1])):
+        for (fault_class, emr) in sorted(groups, key=lambda g: (_ORDER.get(g[0], 99), g[1])):
             entries = groups[(fault_class, emr)]
             live = [e for e in entries if e is not None]
             n, k = len(live), sum(e[0] for e in live)

@@ -187,8 +187,7 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
             row["rank"] = i
         ordered = ranked + [r for r in honest if r[1]["not_ranked"]] + [
             r for b in BLOCKS[1:] for r in runs if r[1]["block"] == b]
-        honest = ranked
-        best_correct, best = honest[0] if honest else ({}, None)
+        best_correct, best = ranked[0] if ranked else ({}, None)
         for correct, row in ordered:
             row["best_honest"] = best["method"] if best else ""
             both = [f for f in correct if f in best_correct]

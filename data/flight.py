@@ -366,14 +366,15 @@ def _ground_truth(flight: str, label: str, topics: dict[str, Topic]) -> Fault | 
     _check_label(flight, label, {_GROUND_TRUTH_TOPICS[t] for t in gt}, gt)
     codes = {t: tuple(dict.fromkeys(topics[t].values("field.data").astype(int).tolist()))
              for t in gt}
-    onset = min(float(topics[t].t[0]) for t in gt)
     first_gt = min(gt, key=lambda t: float(topics[t].t[0]))
+    onset = float(topics[first_gt].t[0])
     sensors = [tp for name, tp in topics.items() if not name.startswith("failure_status")]
-    if sensors and not (min(float(tp.t[0]) for tp in sensors) <= onset
-                        <= max(float(tp.t[-1]) for tp in sensors)):
-        last = max(float(tp.t[-1]) for tp in sensors)
+    first = min((float(tp.t[0]) for tp in sensors), default=onset)
+    last = max((float(tp.t[-1]) for tp in sensors), default=onset)
+    if not first <= onset <= last:
         raise AlfaDataError(f"the fault's onset ({onset:.2f} s on the flight clock) is outside "
-                            f"the recorded data (0 to {last:.2f} s): no data holds the fault",
+                            f"the recorded data ({first:.2f} to {last:.2f} s): no data holds "
+                            "the fault",
                             flight=flight, file=f"{flight}-{first_gt}.csv", column="%time",
                             line=int(topics[first_gt].lines[0]))
     return Fault(

@@ -1,3 +1,4 @@
+import functools
 import os
 import sys
 from pathlib import Path
@@ -47,12 +48,17 @@ def detector_code(method):
     return module_sources(REGISTRY[config["methods"][method]["detector"]])
 
 
-def figure_fault_class(wildcards):
-    """The report files each flight's figure under its fault class (from the manifest)."""
+@functools.cache
+def _fault_classes():
+    """Each flight's fault class, from the manifest, read once per report."""
     from alfa_bench.data import read_manifest
 
-    manifest = read_manifest("results/flights.csv").set_index("flight")
-    return manifest.at[wildcards.flight, "fault_class"]
+    return read_manifest("results/flights.csv").set_index("flight")["fault_class"].to_dict()
+
+
+def figure_fault_class(wildcards):
+    """The report files each flight's figure under its fault class."""
+    return _fault_classes()[wildcards.flight]
 
 
 # ALFA_DIR, else the config's alfa_dir, else the downloaded archive.
