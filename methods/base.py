@@ -2,10 +2,11 @@
 
 A detector is built from hyper-parameters only; :meth:`Detector.reset` creates its
 learned state (attributes ending in ``_``); :meth:`Detector.update` consumes one
-time step of the signals it asks for and returns, per score channel, the score and
-the alarm of that step. A channel alarms exactly when its score exceeds its
-threshold (:meth:`Detector.thresholds`), so stored scores can be re-thresholded
-without re-running the detector. A flight alarms when any channel alarms.
+time step of the signals it asks for and returns the score of each channel for that
+step. A channel alarms exactly when its score exceeds its threshold
+(:meth:`Detector.thresholds`): :meth:`Detector.alarms` derives the alarms from the
+scores, for every detector alike, so stored scores can be re-thresholded without
+re-running the detector. A flight alarms when any channel alarms.
 :meth:`Detector.probes` exposes the intermediates of the last step (prediction,
 residual, ...) for inspection.
 
@@ -117,25 +118,30 @@ class Detector(ABC):
         """Forget everything learned while running (not what :meth:`fit` learned);
         return self."""
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, np.ndarray, dict]:
-        """:meth:`reset`, then :meth:`update` over every step of ``s``: scores and
-        alarms, shape (n, c), and with ``probes`` the :meth:`probes` of every step.
-        Detectors may override it with a batch form; it must give the same alarms and
-        the same scores to rounding (the contract test checks)."""
+    def alarms(self, score: np.ndarray) -> np.ndarray:
+        """Alarms of scores of shape (..., c): :math:`s_c(k) > \\gamma_c`; a NaN score
+        (a channel not armed) never alarms."""
+        with np.errstate(invalid="ignore"):
+            return np.asarray(score) > self.thresholds()
+
+    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
+        """:meth:`reset`, then :meth:`update` over every step of ``s``: scores, shape
+        (n, c), and with ``probes`` the :meth:`probes` of every step. Detectors may
+        override it with a batch form; it must give the same scores to rounding (the
+        contract test checks)."""
         self.reset()
         n, c = s.t.size, len(self.channels())
         score = np.empty((n, c))
-        alarm = np.empty((n, c), dtype=bool)
         names = list(self.probes()) if probes else []
         kept = np.full((n, len(names)), np.nan)
         for k in range(n):
-            score[k], alarm[k] = self.update(s.x[k], s.fresh[k])
+            score[k] = self.update(s.x[k], s.fresh[k])
             if names:
                 kept[k] = list(self.probes().values())
-        return score, alarm, {name: kept[:, i] for i, name in enumerate(names)}
+        return score, {name: kept[:, i] for i, name in enumerate(names)}
 
     @abstractmethod
-    def update(self, x: np.ndarray, fresh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def update(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:
         """Consume one time step.
 
         Parameters
@@ -148,8 +154,8 @@ class Detector(ABC):
         Returns
         -------
         score : ndarray, shape (c,)
-            Per channel; NaN while the channel is not yet armed.
-        alarm : ndarray of bool, shape (c,)
+            Per channel; NaN while the channel is not yet armed. Its alarms are
+            :meth:`alarms` of it.
         """
 
 
@@ -262,13 +268,12 @@ def run_detector(detector: Detector, flight: Flight, probes: bool = False) -> Tr
     keep :meth:`Detector.probes` of every step. Channels on signals the flight does not
     measure are skipped (:func:`skipped_channels`)."""
     s = sample(flight, detector.signals(), detector.rate_hz)
-    score, alarm, kept = detector.run(s, probes)
+    score, kept = detector.run(s, probes)
     skipped = skipped_channels(detector, not_measured(flight, detector.signals()))
     if skipped:
-        cols = [detector.channels().index(ch) for ch in skipped]
-        score[:, cols], alarm[:, cols] = np.nan, False
+        score[:, [detector.channels().index(ch) for ch in skipped]] = np.nan
         log.info("%s: skipped %s", flight.id, skipped)
-    return Trace(t=s.t, score=score, alarm=alarm, channels=detector.channels(),
+    return Trace(t=s.t, score=score, alarm=detector.alarms(score), channels=detector.channels(),
                  threshold=np.asarray(detector.thresholds(), dtype=float), probes=kept,
                  skipped=skipped)
 

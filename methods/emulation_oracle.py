@@ -114,7 +114,7 @@ class EmulationOracle(Detector):
         self.zero_since_ = -1
         return self
 
-    def update(self, x: np.ndarray, fresh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def update(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:
         k = self.steps_
         self.since_ = np.where(fresh, 0.0, self.since_ + 1.0)
         if x[-1] == 0.0:
@@ -124,12 +124,12 @@ class EmulationOracle(Detector):
         zero = 0.0 if self.zero_since_ < 0 else (k - self.zero_since_) / self.rate_hz
         self.steps_ = k + 1
         score = np.r_[self.since_ / self.rate_hz, zero]
-        return score, score > self.thresholds()
+        return score
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, np.ndarray, dict]:
+    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
         """:meth:`update` over ``s``, on whole columns."""
         self.reset()
         flat, zero = _spells(s.x, s.fresh, self.rate_hz)
         score = np.column_stack([flat, zero])
         self.steps_ = s.t.size
-        return score, score > self.thresholds(), {}
+        return score, {}

@@ -72,6 +72,7 @@ from alfa_bench.data import SIGNALS, Sampled
 from . import kernels
 from .base import Detector
 from .glrt import WindowedGlrt, empirical_threshold, glrt_statistic
+from .kernels import FfrlsConfig, FfrlsCount, FfrlsOut
 from .rls import RecursiveLeastSquares
 
 __all__ = ["DEFAULT_MODELS", "SERVO_MODELS", "FfRlsMonitor", "joint_thresholds",
@@ -142,8 +143,8 @@ class _Model:
         self.ar = bool(spec["autoregressive"])
         self.n = len(self.u_cols) + self.ar + 1
         self.rls = RecursiveLeastSquares(self.n, det.p0, det.forgetting,
-                                         det.max_trace_ratio * np.trace(det.cov0_[spec["name"]])
-                                         if hasattr(det, "cov0_") else np.inf)
+                                         det.max_trace_ratio * np.trace(det.P0_[spec["name"]])
+                                         if hasattr(det, "P0_") else np.inf)
         self.y_prev = math.nan
         self.thetas = deque(maxlen=det._window() + 1)
         self.frozen = False
@@ -172,7 +173,7 @@ class FfRlsMonitor(Detector):
 
     Attributes
     ----------
-    theta0_, cov0_ : dict
+    theta0_, P0_ : dict
         Fitted a-priori parameters and covariance per model.
     res_mean_, res_var_, dtheta_cov_, dtheta_info_ : dict
         Fault-free statistics of :math:`\\varepsilon` and :math:`\\Delta\\hat\\theta`
@@ -180,7 +181,7 @@ class FfRlsMonitor(Detector):
     gamma_r_, gamma_r_joint_, gamma_theta_joint_ : dict
         Thresholds per model.
     models_ : list
-        Per-model state: ``rls`` (``theta_``, ``cov_``, ``error_``, ``gain_``),
+        Per-model state: ``rls`` (``theta_``, ``P_``, ``error_``, ``K_``),
         ``frozen``.
     """
 
@@ -221,11 +222,11 @@ class FfRlsMonitor(Detector):
 
     def fit(self, segments: list[Sampled]) -> FfRlsMonitor:
         names = [m["name"] for m in self.models]
-        for attr in ("theta0_", "cov0_", "gamma_r_"):
+        for attr in ("theta0_", "P0_", "gamma_r_"):
             self.__dict__.pop(attr, None)
         finals = [self._calibration_run(s, final=True) for s in segments]
         self.theta0_ = {n: np.mean([f[n][0] for f in finals], axis=0) for n in names}
-        self.cov0_ = {n: np.mean([f[n][1] for f in finals], axis=0) for n in names}
+        self.P0_ = {n: np.mean([f[n][1] for f in finals], axis=0) for n in names}
 
         runs = [self._calibration_run(s, final=False) for s in segments]
         self.res_mean_, self.res_var_, self.dtheta_cov_, self.dtheta_info_ = {}, {}, {}, {}
@@ -254,7 +255,7 @@ class FfRlsMonitor(Detector):
         for spec in self.models:
             r = self._kernel_run(s, spec, from_prior=not final, freeze=False)
             ok = np.isfinite(r["g"])
-            out[spec["name"]] = ((r["theta"], r["cov"]) if final
+            out[spec["name"]] = ((r["theta"], r["P"]) if final
                                  else (r["eps"][ok], r["dtheta"][ok]))
         return out
 
@@ -266,32 +267,37 @@ class FfRlsMonitor(Detector):
         y = np.ascontiguousarray(s.x[:, cols[spec["output"]]])
         n_par = len(spec["inputs"]) + bool(spec["autoregressive"]) + 1
         name = spec["name"]
-        if from_prior:
-            theta, cov = self.theta0_[name].copy(), self.cov0_[name].copy()
-            max_trace = self.max_trace_ratio * float(np.trace(cov))
-        else:
-            theta, cov, max_trace = np.zeros(n_par), np.eye(n_par) * self.p0, np.inf
-        fitted = hasattr(self, "gamma_r_")
         m, n = self._window(), s.t.size
-        r = {k: np.empty(n) for k in ("eps", "g", "t", "joint")}
-        r["dtheta"] = np.empty((n, n_par))
-        kernels.ffrls_advance(
-            np.ascontiguousarray(u), y, bool(spec["autoregressive"]), theta, cov,
-            float(self.forgetting), max_trace, np.zeros(n_par), np.zeros(n_par),
-            np.array([np.nan]), np.zeros((m + 1, n_par)), np.zeros(1, dtype=np.int64),
-            self.res_mean_[name] if fitted else 0.0, self.res_var_[name] if fitted else 1.0,
-            np.zeros(m), np.zeros(1, dtype=np.int64),
-            self.dtheta_info_[name] if fitted else np.zeros((n_par, n_par)),
-            self.gamma_r_joint_[name] if fitted else 1.0,
-            self.gamma_theta_joint_[name] if fitted else 1.0, freeze, np.zeros(1, dtype=bool),
-            r["eps"], r["dtheta"], r["g"], r["t"], r["joint"])
-        r["theta"], r["cov"], r["y"] = theta, cov, y
+        config = np.zeros(len(FfrlsConfig))
+        counts = np.zeros(len(FfrlsCount), dtype=np.int64)
+        state = np.zeros(kernels.ffrls_state_size(n_par, m))
+        theta, P, _, _, y_prev, _, _ = kernels.ffrls_views.py_func(state, n_par, m)
+        y_prev[0] = np.nan
+        if from_prior:
+            theta[:], P[:] = self.theta0_[name], self.P0_[name]
+            max_trace = self.max_trace_ratio * float(np.trace(P))
+        else:
+            P[:], max_trace = np.eye(n_par) * self.p0, np.inf
+        fitted = hasattr(self, "gamma_r_")
+        config[[FfrlsConfig.AR, FfrlsConfig.LAM, FfrlsConfig.MAX_TRACE, FfrlsConfig.FREEZE,
+                FfrlsConfig.M]] = spec["autoregressive"], self.forgetting, max_trace, freeze, m
+        config[[FfrlsConfig.RES_MEAN, FfrlsConfig.SIGMA2, FfrlsConfig.GAMMA_R_JOINT,
+                FfrlsConfig.GAMMA_THETA_JOINT]] = (
+            (self.res_mean_[name], self.res_var_[name], self.gamma_r_joint_[name],
+             self.gamma_theta_joint_[name]) if fitted else (0.0, 1.0, 1.0, 1.0))
+        out = np.empty((len(FfrlsOut), n))
+        r = {"dtheta": np.empty((n, n_par))}
+        kernels.ffrls_advance(np.ascontiguousarray(u), y, config, counts, state,
+                              self.dtheta_info_[name] if fitted else np.zeros((n_par, n_par)),
+                              out, r["dtheta"])
+        r.update({row.name.lower(): out[row] for row in FfrlsOut})
+        r["theta"], r["P"], r["y"] = theta.copy(), P.copy(), y
         return r
 
     def fitted(self) -> dict:
         self._check_fitted("gamma_r_")
         return {n: {"theta0": self.theta0_[n].tolist(),
-                    "trace_cov0": float(np.trace(self.cov0_[n])),
+                    "trace_cov0": float(np.trace(self.P0_[n])),
                     "residual_mean": self.res_mean_[n], "residual_var": self.res_var_[n],
                     "gamma_r": self.gamma_r_[n], "gamma_r_joint": self.gamma_r_joint_[n],
                     "gamma_theta_joint": self.gamma_theta_joint_[n]}
@@ -309,7 +315,7 @@ class FfRlsMonitor(Detector):
         self.models_ = [_Model(self, spec, cols) for spec in self.models]
         for spec, m in zip(self.models, self.models_, strict=True):
             if theta0:
-                m.rls.reset(self.theta0_[spec["name"]], self.cov0_[spec["name"]])
+                m.rls.reset(self.theta0_[spec["name"]], self.P0_[spec["name"]])
             else:
                 m.rls.reset()
 
@@ -339,9 +345,8 @@ class FfRlsMonitor(Detector):
             return eps, None
         return eps, m.thetas[-1] - m.thetas[0]             # theta(k) - theta(k - M)
 
-    def update(self, x: np.ndarray, fresh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def update(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:
         score = np.full(2 * len(self.models), np.nan)
-        alarm = np.zeros(2 * len(self.models), dtype=bool)
         for j, (spec, m) in enumerate(zip(self.models, self.models_, strict=True)):
             n = spec["name"]
             eps, dtheta = self._model_step(m, x)
@@ -353,10 +358,9 @@ class FfRlsMonitor(Detector):
             m.frozen = g > self.gamma_r_joint_[n]      # stop adapting while residual test is up
             joint = min(g / self.gamma_r_joint_[n], t / self.gamma_theta_joint_[n])
             score[2 * j], score[2 * j + 1] = g, joint
-            alarm[2 * j], alarm[2 * j + 1] = g > self.gamma_r_[n], joint > 1.0
-        return score, alarm
+        return score
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, np.ndarray, dict]:
+    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
         """The compiled form of :meth:`update` over ``s`` (equal to rounding)."""
         self.reset()
         score, kept = [], {}
@@ -367,7 +371,4 @@ class FfRlsMonitor(Detector):
                 kept[f"{spec['name']}/prediction"] = r["y"] - r["eps"]
                 kept[f"{spec['name']}/residual"] = r["eps"]
                 kept[f"{spec['name']}/parameter_change"] = r["t"]
-        score = np.column_stack(score)
-        thr = self.thresholds()
-        with np.errstate(invalid="ignore"):
-            return score, score > thr, kept
+        return np.column_stack(score), kept

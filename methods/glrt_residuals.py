@@ -164,11 +164,10 @@ class GlrtResiduals(PairDetector):
         self._reset_glrt()
         return self
 
-    def update(self, x: np.ndarray, fresh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        g = self._glrt_step(self._residual_step(x, fresh))
-        return g, g > self.threshold_
+    def update(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:
+        return self._glrt_step(self._residual_step(x, fresh))
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, np.ndarray, dict]:
+    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
         """The batch form: residuals of the whole segment at once, then the GLRT kernel;
         equal to streaming to rounding."""
         self.reset()
@@ -179,8 +178,7 @@ class GlrtResiduals(PairDetector):
             for j, (p, (_, iy)) in enumerate(zip(self.pairs, self.cols_, strict=True)):
                 kept[f"{p['name']}/prediction"] = s.x[:, iy] - r[:, j]
                 kept[f"{p['name']}/residual"] = r[:, j]
-        with np.errstate(invalid="ignore"):
-            return g, g > self.threshold_, kept
+        return g, kept
 
     def _validate(self) -> None:
         if self.residuals not in _RESIDUALS:

@@ -192,12 +192,11 @@ class KalmanOkid(Detector):
         self._reset_filters()
         return self
 
-    def update(self, x: np.ndarray, fresh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def update(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:
         e = self._innovation_step(x)
-        nis = (e - self.innovation_mean_) ** 2 / self.innovation_var_  # nu = (e - mu)^2 / s
-        return nis, nis > self.threshold_
+        return (e - self.innovation_mean_) ** 2 / self.innovation_var_  # nu = (e - mu)^2 / s
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, np.ndarray, dict]:
+    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
         """The batch form, through :func:`~.kernels.kalman_innovations`."""
         self.reset()
         e = self._innovations(s)
@@ -208,5 +207,4 @@ class KalmanOkid(Detector):
             for i, name in enumerate(self.outputs):
                 kept[f"{name}/prediction"] = y[:, i] - e[:, i]
                 kept[f"{name}/innovation"] = e[:, i]
-        with np.errstate(invalid="ignore"):
-            return nis, nis > self.threshold_, kept
+        return nis, kept

@@ -161,10 +161,10 @@ class LearnedFusion(Detector):
         self.last_ = math.nan
         return self
 
-    def update(self, x: np.ndarray, fresh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def update(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:
         self.bank_.update(x, fresh)
         self.last_ = float(self._anomaly(self.bank_.last_["step"][None, :])[0])
-        return np.array([self.last_]), np.array([self.last_ > self.gamma_])
+        return np.array([self.last_])
 
     def probes(self) -> dict[str, float]:
         last = getattr(self, "bank_", None)
@@ -172,12 +172,11 @@ class LearnedFusion(Detector):
         return {f"{m['name']}/step": (float(steps[c]) if steps is not None else math.nan)
                 for c, m in enumerate(self.models)}
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, np.ndarray, dict]:
+    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
         """The batch form of :meth:`update` over ``s`` (equal to rounding)."""
         self.reset()
         d = self.bank_.steps(self.bank_.residuals(s)[1])
         score = self._anomaly(d)[:, None]
         kept = ({f"{m['name']}/step": d[:, c] for c, m in enumerate(self.models)}
                 if probes else {})
-        with np.errstate(invalid="ignore"):
-            return score, score > self.gamma_, kept
+        return score, kept

@@ -371,7 +371,7 @@ class ResidualBank(Detector):
                       "step": np.full(c, np.nan)}
         return self
 
-    def update(self, x: np.ndarray, fresh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def update(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:
         h = self.history_
         lags = h["lags"]
         h["k"] += 1
@@ -402,16 +402,14 @@ class ResidualBank(Detector):
             at = [(h["k"] - back) % (span + 1) for back in (0, h["nw"], span)]
             d = _step(*(h["total"][i] for i in at), *(h["count"][i] for i in at)) / h["sigma"]
         self.last_ = {"prediction": pred, "residual": res, "step": d}
-        score = self.scores(d)
-        with np.errstate(invalid="ignore"):
-            return score, score > h["gamma"]
+        return self.scores(d)
 
     def probes(self) -> dict[str, float]:
         last = getattr(self, "last_", None)
         return {f"{m['name']}/{key}": (float(last[key][c]) if last else math.nan)
                 for c, m in enumerate(self.models) for key in ("prediction", "residual", "step")}
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, np.ndarray, dict]:
+    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
         """The batch form of :meth:`update` over ``s`` (equal to rounding)."""
         self.reset()
         pred, res = self.residuals(s)
@@ -422,8 +420,7 @@ class ResidualBank(Detector):
             for c, m in enumerate(self.models):
                 kept.update({f"{m['name']}/prediction": pred[:, c],
                              f"{m['name']}/residual": res[:, c], f"{m['name']}/step": d[:, c]})
-        with np.errstate(invalid="ignore"):
-            return score, score > self.thresholds(), kept
+        return score, kept
 
 
 def step_means(values: np.ndarray, have: np.ndarray, nw: int, nb: int) -> np.ndarray:

@@ -8,7 +8,7 @@ For each input/output pair :math:`(u, y)` an ARX model (eq. 3)
 
 is estimated online by RLS (eqs. 4-7 of :mod:`.rls`) from
 :math:`\hat\theta = 0` and a large diagonal covariance. The model is *stable* once
-:math:`\|L(k)\hat e(k)\|_\infty < \epsilon` has held for ``stable_s`` seconds, and
+:math:`\|K(k)\hat e(k)\|_\infty < \epsilon` has held for ``stable_s`` seconds, and
 not before ``warmup_samples`` steps. From then on the prediction error's mean and
 variance are tracked by Welford's method (eq. 8); once the variance is stable
 too (relative change per update below ``var_rtol`` for ``var_stable_s`` seconds),
@@ -68,6 +68,7 @@ from alfa_bench.data import Sampled
 
 from . import kernels
 from .base import PairDetector
+from .kernels import ArxConfig, ArxCount, ArxOut, ArxStat
 
 __all__ = ["DEFAULT_PAIRS", "RlsArxZscore"]
 
@@ -82,35 +83,40 @@ _REPEATED = ("hold", "fresh")
 
 
 class _Pair:
-    """State of one input/output pair, in the arrays :func:`~.kernels.rls_arx_advance`
-    advances."""
+    """State of one input/output pair: the ``config``, ``counts`` and ``state`` arrays
+    :func:`~.kernels.rls_arx_advance` advances, and the named views of ``state``
+    (:func:`~.kernels.arx_views`)."""
 
     def __init__(self, det: RlsArxZscore, u_col: int, y_col: int):
         self.u_col, self.y_col = u_col, y_col
-        nb = max(1, round(det.input_window_s * det.rate_hz))
-        n = det.na + nb
-        self.theta = np.zeros(n)                       # theta(0) = 0
-        self.cov = np.eye(n) * det.p0                  # C(0) = p0 I
-        self.ubuf = np.zeros(nb)
-        self.ybuf = np.zeros(max(det.na, 1))
-        self.phi, self.c_phi, self.gain = np.zeros(n), np.zeros(n), np.zeros(n)
-        self.ints = np.zeros(kernels.ARX_INTS, dtype=np.int64)
-        self.ints[[kernels.STREAK_FROM, kernels.VAR_FROM]] = -1
-        self.floats = np.zeros(kernels.ARX_FLOATS)
-        self.floats[kernels.LAST_VAR] = np.nan
+        na, nb = det.na, max(1, round(det.input_window_s * det.rate_hz))
+        self.config = np.zeros(len(ArxConfig))
+        self.config[[ArxConfig.NA, ArxConfig.NB, ArxConfig.WARMUP, ArxConfig.EPS,
+                     ArxConfig.STABLE_STEPS, ArxConfig.VAR_RTOL, ArxConfig.VAR_STEPS,
+                     ArxConfig.FRESH_ONLY]] = (
+            na, nb, det.warmup_samples, det.eps, round(det.stable_s * det.rate_hz),
+            det.var_rtol, round(det.var_stable_s * det.rate_hz),
+            det.repeated_samples == "fresh")
+        self.counts = np.zeros(len(ArxCount), dtype=np.int64)
+        self.counts[[ArxCount.STREAK_FROM, ArxCount.VAR_FROM]] = -1
+        self.state = np.zeros(kernels.arx_state_size(na, nb))
+        (self.theta, self.P, self.u_hist, self.y_hist, self.phi, self.P_phi, self.K,
+         self.stats) = kernels.arx_views.py_func(self.state, na, nb)
+        self.P[:] = np.eye(na + nb) * det.p0           # P(0) = p0 I, theta(0) = 0
+        self.stats[ArxStat.LAST_VAR] = np.nan
 
     @property
     def updates(self) -> int:
         """RLS updates made."""
-        return int(self.ints[kernels.UPDATES])
+        return int(self.counts[ArxCount.UPDATES])
 
     @property
     def model_stable(self) -> bool:
-        return bool(self.ints[kernels.MODEL_STABLE])
+        return bool(self.counts[ArxCount.MODEL_STABLE])
 
     @property
     def var_stable(self) -> bool:
-        return bool(self.ints[kernels.VAR_STABLE])
+        return bool(self.counts[ArxCount.VAR_STABLE])
 
 
 class RlsArxZscore(PairDetector):
@@ -127,11 +133,11 @@ class RlsArxZscore(PairDetector):
     input_window_s : float
         Seconds of inputs in the regressor; :math:`n_b` = round(window x rate).
     p0 : float
-        Initial RLS covariance :math:`C(0) = p_0 I`.
+        Initial RLS covariance :math:`P(0) = p_0 I`.
     warmup_samples : int
         Steps before a model may be declared stable.
     eps, stable_s : float
-        Model stability: :math:`\\|L\\hat e\\|_\\infty < \\epsilon` for ``stable_s``.
+        Model stability: :math:`\\|K\\hat e\\|_\\infty < \\epsilon` for ``stable_s``.
     var_rtol, var_stable_s : float
         Variance stability.
     z_threshold : float
@@ -140,8 +146,8 @@ class RlsArxZscore(PairDetector):
     Attributes
     ----------
     pairs_ : list
-        Per-pair state: ``theta``, ``cov``, the regressor buffers, Welford's
-        statistics, flags ``model_stable`` and ``var_stable``.
+        Per-pair state: ``theta``, ``P``, the regressor histories, Welford's
+        ``stats``, flags ``model_stable`` and ``var_stable``.
     last_ : dict of ndarray
         Per pair, the outputs of the last step (see :meth:`advance`).
     """
@@ -176,8 +182,6 @@ class RlsArxZscore(PairDetector):
             raise ValueError(f"na must be >= 0, got {self.na}")
         cols = {s: i for i, s in enumerate(self.signals())}
         self.pairs_ = [_Pair(self, cols[p["input"]], cols[p["output"]]) for p in self.pairs]
-        self.stable_steps_ = round(self.stable_s * self.rate_hz)
-        self.var_steps_ = round(self.var_stable_s * self.rate_hz)
         self.last_ = {k: np.full((1, len(self.pairs)), np.nan) for k in _OUTPUTS}
         return self
 
@@ -187,31 +191,26 @@ class RlsArxZscore(PairDetector):
         and ``judged``, the residual of a pair whose model was already stable."""
         x = np.asarray(x, dtype=float)
         n = x.shape[0]
-        out = {k: np.empty((len(self.pairs_), n)) for k in _OUTPUTS}
+        out = np.empty((len(self.pairs_), len(ArxOut), n))
         for j, p in enumerate(self.pairs_):
             kernels.rls_arx_advance(
                 np.ascontiguousarray(x[:, p.u_col]), np.ascontiguousarray(x[:, p.y_col]),
-                np.ascontiguousarray(fresh[:, p.y_col]), p.ints, p.floats, p.theta, p.cov,
-                p.ubuf, p.ybuf, p.phi, p.c_phi, p.gain, self.na, self.warmup_samples,
-                self.eps, self.stable_steps_, self.var_rtol, self.var_steps_,
-                self.repeated_samples == "fresh", out["z"][j], out["prediction"][j],
-                out["residual"][j], out["judged"][j])
-        out = {k: v.T for k, v in out.items()}
+                np.ascontiguousarray(fresh[:, p.y_col]), p.config, p.counts, p.state, out[j])
+        out = {k: out[:, row].T for k, row in zip(_OUTPUTS, ArxOut, strict=True)}
         self.last_ = {k: v[-1:] for k, v in out.items()}
         return out
 
-    def update(self, x: np.ndarray, fresh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        z = self.advance(x[None, :], fresh[None, :])["z"][0]
-        return z, z > self.z_threshold
+    def update(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:
+        return self.advance(x[None, :], fresh[None, :])["z"][0]
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, np.ndarray, dict]:
+    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
         out = self.reset().advance(s.x, s.fresh)
         kept = ({name: out[kind][:, j] for name, (kind, j) in _probe_index(self.pairs).items()}
                 if probes else {})
-        return out["z"], out["z"] > self.z_threshold, kept
+        return out["z"], kept
 
 
-_OUTPUTS = ("z", "prediction", "residual", "judged")
+_OUTPUTS = tuple(row.name.lower() for row in ArxOut)
 
 
 def _probe_index(pairs) -> dict[str, tuple[str, int]]:

@@ -27,17 +27,17 @@ class PlainRecursiveLeastSquares(RecursiveLeastSquares):
         """One RLS step; returns the a-priori error :math:`\\hat e(k)`."""
         lam = self.forgetting
         e = y - phi @ self.theta_                      # (4) e = y - phi' theta
-        c_phi = self.cov_ @ phi
-        gain = c_phi / (lam + phi @ c_phi)             # (5) L = C phi / (lam + phi' C phi)
-        step = gain * e
-        self.theta_ = self.theta_ + step               # (6) theta += L e
-        cov = (self.cov_ - np.outer(gain, c_phi)) / lam  # (7) C = (C - L phi' C) / lam
-        cov = 0.5 * (cov + cov.T)                      # keep C symmetric against round-off
-        trace = np.trace(cov)
+        P_phi = self.P_ @ phi
+        K = P_phi / (lam + phi @ P_phi)                # (5) K = P phi / (lam + phi' P phi)
+        step = K * e
+        self.theta_ = self.theta_ + step               # (6) theta += K e
+        P = (self.P_ - np.outer(K, P_phi)) / lam       # (7) P = (P - K phi' P) / lam
+        P = 0.5 * (P + P.T)                            # keep P symmetric against round-off
+        trace = np.trace(P)
         if trace > self.max_trace:
-            cov *= self.max_trace / trace              # tr C <= max_trace: no wind-up
-        self.cov_ = cov
-        self.error_, self.gain_, self.step_ = float(e), gain, step
+            P *= self.max_trace / trace                # tr P <= max_trace: no wind-up
+        self.P_ = P
+        self.error_, self.K_, self.step_ = float(e), K, step
         return self.error_
 
 
@@ -97,7 +97,7 @@ class PlainRlsArxZscore(RlsArxZscore):
     Attributes
     ----------
     pairs_ : list
-        Per-pair state: ``rls`` (with ``theta_``, ``error_``, ``gain_``),
+        Per-pair state: ``rls`` (with ``theta_``, ``error_``, ``K_``),
         ``welford``, flags ``model_stable`` and ``var_stable``.
     """
 
@@ -111,21 +111,16 @@ class PlainRlsArxZscore(RlsArxZscore):
         return out
 
     def reset(self) -> PlainRlsArxZscore:
-        super().reset()                                # validation and step counts
+        super().reset()                                # validation
+        self.stable_steps_ = round(self.stable_s * self.rate_hz)
+        self.var_steps_ = round(self.var_stable_s * self.rate_hz)
         cols = {s: i for i, s in enumerate(self.signals())}
         self.pairs_ = [_Pair(self, cols[p["input"]], cols[p["output"]]) for p in self.pairs]
         return self
 
-    def update(self, x: np.ndarray, fresh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        n = len(self.pairs_)
-        score = np.full(n, np.nan)
-        alarm = np.zeros(n, dtype=bool)
-        for j, pair in enumerate(self.pairs_):
-            z = self._step(pair, float(x[pair.u_col]), float(x[pair.y_col]),
-                           bool(fresh[pair.y_col]))
-            score[j] = z
-            alarm[j] = z > self.z_threshold
-        return score, alarm
+    def update(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:
+        return np.array([self._step(pair, float(x[pair.u_col]), float(x[pair.y_col]),
+                                    bool(fresh[pair.y_col])) for pair in self.pairs_])
 
     def _step(self, p: _Pair, u: float, y: float, fresh: bool) -> float:
         k = p.k

@@ -33,9 +33,9 @@ def test_covariance_winds_up_without_excitation_and_the_guard_bounds_it():
     for _ in range(steps):
         free.update(phi, 1.0)
         guarded.update(phi, 1.0)
-    assert free.cov_[0, 0] == pytest.approx(lam ** -steps, rel=1e-6)
-    assert np.trace(guarded.cov_) <= 10.0 + 1e-9
-    assert np.all(np.linalg.eigvalsh(guarded.cov_) > 0)
+    assert free.P_[0, 0] == pytest.approx(lam ** -steps, rel=1e-6)
+    assert np.trace(guarded.P_) <= 10.0 + 1e-9
+    assert np.all(np.linalg.eigvalsh(guarded.P_) > 0)
     # the guarded estimator still learns what is excited
     assert guarded.theta_[1] == pytest.approx(1.0, abs=1e-3)
 

@@ -96,5 +96,5 @@ def test_glrt_residuals_identifies_the_arx_model_and_finds_the_change():
     r = [streamed._residual_step(x, f) for x, f in zip(s.x, s.fresh, strict=True)]
     np.testing.assert_allclose(np.array(r), det._residual_run(s), rtol=1e-9)
     det.reset()
-    alarms = np.array([det.update(x, f)[1][0] for x, f in zip(s.x, s.fresh, strict=True)])
+    alarms = np.array([det.alarms(det.update(x, f))[0] for x, f in zip(s.x, s.fresh, strict=True)])
     assert alarms[600:640].any()

@@ -39,8 +39,8 @@ def test_rls_step_matches_the_plain_numpy_step(lam, max_trace):
         y = phi @ [1, -2, 0.5, 0, 3] + rng.normal()
         assert fast.update(phi, y) == pytest.approx(plain.update(phi, y), rel=1e-9, abs=1e-9)
     np.testing.assert_allclose(fast.theta_, plain.theta_, rtol=1e-9)
-    np.testing.assert_allclose(fast.cov_, plain.cov_, rtol=1e-9, atol=1e-12)
-    np.testing.assert_allclose(fast.gain_, plain.gain_, rtol=1e-9, atol=1e-15)
+    np.testing.assert_allclose(fast.P_, plain.P_, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(fast.K_, plain.K_, rtol=1e-9, atol=1e-15)
 
 
 def test_glrt_kernel_is_the_streaming_glrt_bit_for_bit():

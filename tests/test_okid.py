@@ -82,6 +82,6 @@ def test_kalman_okid_alarms_on_a_stuck_sensor():
     y[1000:] = y[1000]                                         # stuck at its last value
     s = sampled(u, y)
     det.reset()
-    alarms = np.array([det.update(x, f)[1][0] for x, f in zip(s.x, s.fresh, strict=True)])
+    alarms = np.array([det.alarms(det.update(x, f))[0] for x, f in zip(s.x, s.fresh, strict=True)])
     assert not alarms[100:1000].mean() > 0.01
     assert alarms[1000:1100].any()

@@ -93,7 +93,7 @@ def test_a_step_is_found_within_the_window(bank, name):
     c = bank.channels().index(name)
     size = -3.0 * bank.gamma_[name] * bank.sigma_[name]   # a drop: thrust is one-sided
     s = world(np.random.default_rng(100 + c), step=(name, size, 60.0))
-    score, alarm, _ = bank.run(s)
+    alarm = bank.alarms(bank.run(s)[0])
     first = s.t[np.argmax(alarm[:, c])] if alarm[:, c].any() else None
     assert first is not None and 60.0 <= first <= 60.0 + bank.window_s
     assert not alarm[s.t < 60.0].any()
@@ -103,7 +103,7 @@ def test_thrust_is_one_sided(bank):
     c = bank.channels().index("thrust")
     rise = 3.0 * bank.gamma_["thrust"] * bank.sigma_["thrust"]
     s = world(np.random.default_rng(3), step=("thrust", rise, 60.0))
-    assert not bank.run(s)[1][:, c].any()
+    assert not bank.alarms(bank.run(s)[0])[:, c].any()
 
 
 def test_false_alarms_per_flight_match_the_budget(training):
@@ -111,7 +111,7 @@ def test_false_alarms_per_flight_match_the_budget(training):
     at about the family-wise rate alpha (0.3 here), not per sample."""
     bank = ResidualBank(false_alarm=0.3).fit(training)
     rng = np.random.default_rng(11)
-    alarmed = [bank.run(world(rng))[1].any() for _ in range(40)]
+    alarmed = [bank.alarms(bank.run(world(rng))[0]).any() for _ in range(40)]
     assert 0.1 <= np.mean(alarmed) <= 0.55
 
 
@@ -141,7 +141,7 @@ def test_learned_fusion_sees_a_step(training):
     bank = fusion.bank_
     size = -4.0 * bank.sigma_["side"] * 3.0
     s = world(np.random.default_rng(21), step=("side", size, 60.0))
-    score, alarm, _ = fusion.run(s)
+    alarm = fusion.alarms(fusion.run(s)[0])
     first = s.t[np.argmax(alarm[:, 0])] if alarm.any() else None
     assert first is not None and 60.0 <= first <= 60.0 + fusion.window_s
 

@@ -31,7 +31,7 @@ def test_rls_equals_ridge_solution_at_every_step(p0):
             a = phi[:k + 1].T @ phi[:k + 1] + np.eye(phi.shape[1]) / p0
             ref = np.linalg.solve(a, phi[:k + 1].T @ y[:k + 1])
             np.testing.assert_allclose(rls.theta_, ref, rtol=1e-8, atol=1e-10)
-            np.testing.assert_allclose(rls.cov_, np.linalg.inv(a), rtol=1e-6, atol=1e-12)
+            np.testing.assert_allclose(rls.P_, np.linalg.inv(a), rtol=1e-6, atol=1e-12)
 
 
 def test_rls_matches_statsmodels_recursive_ls():
@@ -51,8 +51,8 @@ def test_a_priori_error_and_gain_are_kept():
     rls = RecursiveLeastSquares(phi.shape[1], p0=10.0).reset()
     e = rls.update(phi[0], y[0])
     assert e == rls.error_ == pytest.approx(y[0])  # theta(0) = 0
-    np.testing.assert_allclose(rls.step_, rls.gain_ * e)
-    np.testing.assert_allclose(rls.gain_, 10 * phi[0] / (1 + 10 * phi[0] @ phi[0]))
+    np.testing.assert_allclose(rls.step_, rls.K_ * e)
+    np.testing.assert_allclose(rls.K_, 10 * phi[0] / (1 + 10 * phi[0] @ phi[0]))
 
 
 def test_forgetting_validated():

@@ -22,9 +22,9 @@ def stream(n=3000, onset=None, seed=0):
 def drive(det, u, y, fresh=None):
     det.reset()
     fresh = np.ones_like(u, dtype=bool) if fresh is None else fresh
-    out = [det.update(np.array([uu, yy]), np.array([True, f]))
-           for uu, yy, f in zip(u, y, fresh, strict=True)]
-    return np.array([s[0] for s, _ in out]), np.array([a[0] for _, a in out])
+    score = np.array([det.update(np.array([uu, yy]), np.array([True, f]))[0]
+                      for uu, yy, f in zip(u, y, fresh, strict=True)])
+    return score, det.alarms(score[:, None])[:, 0]
 
 
 def test_identifies_the_system_and_arms():

@@ -42,7 +42,6 @@ class Cusum(Detector):
     def fit(self, segments):
         x = np.concatenate([s.x[s.fresh[:, 0], 0] for s in segments])
         self.mean_, self.std_ = float(np.mean(x)), float(np.std(x)) or 1.0
-        self.gamma_ = 1.0                         # a placeholder while scoring the training
         peak = max(float(np.max(self.run(s)[0])) for s in segments)
         self.gamma_ = self.margin * max(peak, 1e-9)
         return self
@@ -64,5 +63,4 @@ class Cusum(Detector):
         if fresh[0]:
             z = (x[0] - self.mean_) / self.std_
             self.g_ = np.maximum(0.0, self.g_ + np.array([z, -z]) - self.drift)
-        score = np.array([self.g_.max()])
-        return score, score > self.gamma_
+        return np.array([self.g_.max()])
