@@ -12,10 +12,15 @@ from __future__ import annotations
 
 import pandas as pd
 
-__all__ = ["GROUPINGS", "HeldOutError", "check_held_out", "folds", "groups_of"]
+__all__ = ["GROUPINGS", "HeldOutError", "TooFewGroupsError", "check_held_out", "folds",
+           "groups_of"]
 
 #: manifest column that defines a group
 GROUPINGS = {"date": "date", "flight": "flight"}
+
+
+class TooFewGroupsError(ValueError):
+    """The flights fall in fewer than two groups: none can be left out."""
 
 
 def folds(manifest: pd.DataFrame, group_by: str) -> dict[str, tuple[list[str], list[str]]]:
@@ -27,7 +32,7 @@ def folds(manifest: pd.DataFrame, group_by: str) -> dict[str, tuple[list[str], l
     groups = labelled[GROUPINGS[group_by]].astype(str).to_numpy()
     found = len(dict.fromkeys(groups))
     if found < 2:
-        raise ValueError(f"calibration needs flights from at least two {group_by} groups; "
+        raise TooFewGroupsError(f"calibration needs flights from at least two {group_by} groups; "
                          f"found {found}")
     flights = labelled["flight"].to_numpy()
     # in manifest order (scikit-learn's LeaveOneGroupOut gives the same folds, but every

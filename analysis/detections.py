@@ -73,35 +73,10 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
     train = manifest if calibrate_on is None else calibrate_on
     sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
     sha |= dict(zip(train["flight"], train["sha256"], strict=True))
-    failed: set[str] = set()
-
-    def guarded(stage: str, name: str, fn):
-        if name in failed:
-            return None
-        try:
-            return fn()
-        except AlfaDataError as e:
-            if failures is None:
-                raise
-            failed.add(name)
-            failures.append(failure_row(e, stage, method))
-            log.error("%s: flight %s excluded at %s: %s", method, name, stage, e)
-            return None
-
-    def run(name: str, info: dict | None = None):
-        return guarded("detect", name, lambda: detection_record(
-            method, spec, detector, flights[name], sha, info))
-
-    def uncalibrated(names: list[str], error: ValueError) -> None:
-        if failures is None:
-            raise error
-        # not added to ``failed``: the flights are still fault-free data for other folds
-        failures.extend(calibration_failure(name, method, error, calibration) for name in names)
-        log.error("%s: %d flight(s) excluded, not calibrated: %s", method, len(names), error)
-
+    scorer = _Scorer(method, spec, detector, flights, sha, calibration, failures)
     if not detector.calibrated:
         for name in manifest.loc[manifest["ground_truth"], "flight"]:
-            if (out := run(name)) is not None:
+            if (out := scorer.record(name)) is not None:
                 yield out
         return
     scored = manifest.loc[manifest["ground_truth"]]
@@ -110,7 +85,7 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
     try:
         by_fold = folds(train, calibration["group_by"])
     except ValueError as e:
-        uncalibrated([f for names in scored_by_fold.values() for f in names], e)
+        scorer.uncalibrated([f for names in scored_by_fold.values() for f in names], e)
         return
     group = dict(zip(train["flight"], train[GROUPINGS[calibration["group_by"]]].astype(str),
                      strict=True))
@@ -118,36 +93,87 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
         scored = scored_by_fold.pop(fold, [])
         if not scored:
             continue
-        segments = {f: guarded("calibration", f, lambda f=f: (
-            labelled_segments(detector, [flights[f]]) if detector.supervised else
-            fault_free_segments(detector, [flights[f]], calibration["margin_s"])))
+        info = scorer.fit(fold, training, scored, group)
+        if info is None:
+            continue
+        for name in scored:
+            if (out := scorer.record(name, info)) is not None:
+                yield out
+    if scored_by_fold:
+        scorer.uncalibrated([f for names in scored_by_fold.values() for f in names],
+                            ValueError(f"no calibration flights outside group(s) "
+                                       f"{sorted(scored_by_fold)}"))
+
+
+class _Scorer:
+    """One method's run over flights: each flight's record, made once; a flight's bad
+    data turned into a failure row (or raised, with ``failures`` None), after which the
+    flight is neither scored nor calibrates; and a fold it cannot calibrate turned into
+    failure rows for the flights that fold scores."""
+
+    def __init__(self, method: str, spec: dict, detector: Detector,
+                 flights: Mapping[str, Flight], sha: dict, calibration: dict,
+                 failures: list[dict] | None):
+        self.method, self.spec, self.detector = method, spec, detector
+        self.flights, self.sha, self.calibration = flights, sha, calibration
+        self.failures = failures
+        self.failed: set[str] = set()
+
+    def guarded(self, stage: str, name: str, fn):
+        """``fn()``, or None once flight ``name`` has bad data (at ``stage``)."""
+        if name in self.failed:
+            return None
+        try:
+            return fn()
+        except AlfaDataError as e:
+            if self.failures is None:
+                raise
+            self.failed.add(name)
+            self.failures.append(failure_row(e, stage, self.method))
+            log.error("%s: flight %s excluded at %s: %s", self.method, name, stage, e)
+            return None
+
+    def record(self, name: str, info: dict | None = None) -> tuple[dict, Trace] | None:
+        return self.guarded("detect", name, lambda: detection_record(
+            self.method, self.spec, self.detector, self.flights[name], self.sha, info))
+
+    def uncalibrated(self, names: list[str], error: ValueError) -> None:
+        if self.failures is None:
+            raise error
+        # not added to ``failed``: the flights are still fault-free data for other folds
+        self.failures.extend(calibration_failure(name, self.method, error, self.calibration)
+                             for name in names)
+        log.error("%s: %d flight(s) excluded, not calibrated: %s", self.method, len(names),
+                  error)
+
+    def fit(self, fold: str, training: list[str], scored: list[str],
+            group: dict[str, str]) -> dict | None:
+        """Fit the detector on the readable, measured ``training`` flights of ``fold``;
+        the calibration block of its records, or None if it could not be fitted."""
+        detector, margin_s = self.detector, self.calibration["margin_s"]
+        segments = {f: self.guarded("calibration", f, lambda f=f: (
+            labelled_segments(detector, [self.flights[f]]) if detector.supervised else
+            fault_free_segments(detector, [self.flights[f]], margin_s)))
             for f in training}
         readable = [f for f in training if segments[f] is not None]
         dead = {f: list(d) for f in readable
-                if (d := not_measured(flights[f], detector.signals()))}
+                if (d := not_measured(self.flights[f], detector.signals()))}
         used = [f for f in readable if f not in dead]
         data = [s for f in used for s in segments[f]]
         check_held_out(data, fold, scored, group)
         try:
             detector.fit(data)
         except ValueError as e:
-            uncalibrated(scored, ValueError(f"fold {fold} ({len(used)} calibration flights): "
-                                            f"{e}"))
-            continue
-        log.info("%s: fold %s fitted on %d flights", method, fold, len(used))
-        info = {**calibration, "fold": fold, "flights": used, "not_measured": dead,
+            self.uncalibrated(scored, ValueError(
+                f"fold {fold} ({len(used)} calibration flights): {e}"))
+            return None
+        log.info("%s: fold %s fitted on %d flights", self.method, fold, len(used))
+        return {**self.calibration, "fold": fold, "flights": used, "not_measured": dead,
                 "supervised": detector.supervised,
                 # what reached fit, flight by flight: the spans of its segments, s
                 "segments": {f: [[float(x.t[0]), float(x.t[-1])] for x in segments[f]]
                              for f in used},
                 "fitted": detector.fitted()}
-        for name in scored:
-            if (out := run(name, info)) is not None:
-                yield out
-    if scored_by_fold:
-        uncalibrated([f for names in scored_by_fold.values() for f in names],
-                     ValueError(f"no calibration flights outside group(s) "
-                                f"{sorted(scored_by_fold)}"))
 
 
 def calibration_failure(flight: str, method: str, error: ValueError, calibration: dict) -> dict:

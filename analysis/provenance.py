@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .calibration import folds
+from .calibration import TooFewGroupsError, folds
 
 __all__ = ["PACKAGES", "RUN_FILE", "code_version", "file_sha256", "package_versions", "provenance",
            "read_provenance", "read_table", "run_id", "run_provenance", "stamp", "write_run_file"]
@@ -82,10 +82,12 @@ def run_provenance(config: dict, manifest: pd.DataFrame,
     train = manifest if calibrate_on is None else calibrate_on
     sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
     sha |= dict(zip(train["flight"], train["sha256"], strict=True))
-    try:
-        folds_ = {g: training for g, (_, training) in folds(train, cal["group_by"]).items()}
-    except (TypeError, ValueError):     # no calibration configured, or under two groups
-        folds_ = None
+    folds_ = None
+    if cal is not None:
+        try:
+            folds_ = {g: training for g, (_, training) in folds(train, cal["group_by"]).items()}
+        except TooFewGroupsError:
+            pass                        # no group can be left out: no folds to record
     return provenance(config, {"flight_sha256": sha},
                       calibration={**(cal or {}), "training_flights": folds_})
 
