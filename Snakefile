@@ -31,6 +31,7 @@ rule all:
         rules.per_flight.output,
         rules.deadline.output,
         rules.leakage.output,
+        rules.ceiling.output,
         rules.runtime.output,
         rules.sweep.output,
         rules.flight_figures.output,

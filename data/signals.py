@@ -97,6 +97,8 @@ _ANGLE_BOUNDS = {"roll": (-180.0, 180.0), "pitch": (-90.0, 90.0), "yaw": (-360.0
 _RATE_BOUNDS = (-34.91, 34.91)
 #: a MEMS accelerometer's widest full scale, ±16 g, in m/s^2
 _ACCEL_BOUNDS = (-156.9, 156.9)
+#: a speed over ground or of the wind, m/s: past any small aircraft's, or gale's
+_SPEED_BOUNDS = (-150.0, 150.0)
 #: an RC servo pulse, µs (the standard 1000-2000 µs, extended)
 _PWM_BOUNDS = (500.0, 2500.0)
 
@@ -140,6 +142,21 @@ SIGNALS: dict[str, Signal] = {
                       unit="m/s^2", bounds=_ACCEL_BOUNDS),
     "accel_y": Signal("mavros-imu-data_raw", "field.linear_acceleration.y", "sensor",
                       unit="m/s^2", bounds=_ACCEL_BOUNDS),
+    # the aircraft's energy (~4 Hz): height above home and velocity in mavros's local
+    # ENU frame (x east, y north, z up), and the autopilot's wind estimate (~2 Hz, the
+    # same frame); with the wind, the air-relative speed is live where the pitot is dead
+    "rel_alt": Signal("mavros-global_position-rel_alt", "field.data", "sensor", unit="m",
+                      bounds=(-1000.0, 10000.0)),
+    "vel_east": Signal("mavros-local_position-velocity", "field.twist.linear.x", "sensor",
+                       unit="m/s", bounds=_SPEED_BOUNDS),
+    "vel_north": Signal("mavros-local_position-velocity", "field.twist.linear.y", "sensor",
+                        unit="m/s", bounds=_SPEED_BOUNDS),
+    "vel_up": Signal("mavros-local_position-velocity", "field.twist.linear.z", "sensor",
+                     unit="m/s", bounds=_SPEED_BOUNDS),
+    "wind_east": Signal("mavros-wind_estimation", "field.twist.linear.x", "sensor",
+                        unit="m/s", bounds=_SPEED_BOUNDS),
+    "wind_north": Signal("mavros-wind_estimation", "field.twist.linear.y", "sensor",
+                         unit="m/s", bounds=_SPEED_BOUNDS),
     # servo outputs (~3 Hz). ALFA does not name the channels; the mapping follows the
     # data: channels4 and 5 track roll rate (ailerons, r ~ 0.6-0.9), channels1 pitch rate
     # (elevator), channels2 drops to idle at every engine failure (throttle), channels3

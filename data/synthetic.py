@@ -161,7 +161,47 @@ def write_flight(processed: Path, name: str, *, duration_s: float = 80.0, rate_h
                   [f"{t},{code}" for t in gt_ns.tolist()])
     airspeed_topic(folder, name, t_ns + 5_000_000, rate_hz, np.random.default_rng(seed + 1000))
     errors_topic(folder, name, t_ns + 6_000_000, rate_hz, np.random.default_rng(seed + 4000))
+    energy_topics(folder, name, duration_s, onset_s if fault_topic.endswith("engines") else None,
+                  np.random.default_rng(seed + 5000))
     return folder
+
+
+TWIST_HEADER = ("%time,field.header.seq,field.header.stamp,field.header.frame_id,"
+                "field.twist.linear.x,field.twist.linear.y,field.twist.linear.z,"
+                "field.twist.angular.x,field.twist.angular.y,field.twist.angular.z")
+#: what a lost engine does to the synthetic energy from onset: the climb rate falls by
+#: this much (m/s) and the airspeed decays at this rate (m/s^2), down to 10 m/s
+ENGINE_CLIMB_LOSS, ENGINE_SPEED_DECAY = 2.0, 0.5
+
+
+def energy_topics(folder: Path, name: str, duration_s: float, engine_onset_s: float | None,
+                  rng: np.random.Generator) -> None:
+    """rel_alt and local_position-velocity at 4 Hz, wind_estimation at 2 Hz (ENU, m/s).
+
+    The air-relative speed wanders about 16 m/s along a slowly turning heading, the
+    climb rate about 0 (0.5 sin(0.1 t)), the wind holds (3, 2); the ground velocity is
+    air plus wind and the height integrates the climb rate. From ``engine_onset_s`` the
+    aircraft loses energy (:data:`ENGINE_CLIMB_LOSS`, :data:`ENGINE_SPEED_DECAY`)."""
+    t = np.arange(0.3, duration_s, 0.25)
+    after = (t - engine_onset_s).clip(0) if engine_onset_s is not None else np.zeros(t.size)
+    speed = np.maximum(16.0 + 0.5 * np.sin(0.05 * t) - ENGINE_SPEED_DECAY * after, 10.0)
+    climb = 0.5 * np.sin(0.1 * t) - ENGINE_CLIMB_LOSS * (after > 0) + rng.normal(0, 0.1, t.size)
+    heading = 0.02 * t
+    wind = (3.0, 2.0)
+    east, north = speed * np.cos(heading) + wind[0], speed * np.sin(heading) + wind[1]
+    height = 100.0 + np.cumsum(climb) * 0.25
+    ns = T0_NS + 7_000_000 + np.round(t * 1e9).astype(np.int64)
+    write_csv(folder / f"{name}-mavros-global_position-rel_alt.csv", "%time,field.data",
+              [f"{a},{h!r}" for a, h in zip(ns.tolist(), height.tolist(), strict=True)])
+    write_csv(folder / f"{name}-mavros-local_position-velocity.csv", TWIST_HEADER,
+              [f"{a},{i},{a - 100_000},map,{e!r},{n!r},{c!r},0.0,0.0,0.0"
+               for i, (a, e, n, c) in enumerate(zip(ns.tolist(), east.tolist(), north.tolist(),
+                                                    climb.tolist(), strict=True))])
+    wt = t[::2]
+    gust = rng.normal(0, 0.2, (wt.size, 2)) + wind
+    write_csv(folder / f"{name}-mavros-wind_estimation.csv", TWIST_HEADER,
+              [f"{a + 9_000_000},{i},{a},,{g[0]!r},{g[1]!r},0.0,0.0,0.0,0.0"
+               for i, (a, g) in enumerate(zip(ns[::2].tolist(), gust.tolist(), strict=True))])
 
 
 def airspeed_topic(folder: Path, name: str, t_ns: np.ndarray, rate_hz: float,

@@ -102,3 +102,23 @@ rule leakage:
         "results/logs/leakage.log",
     script:
         "../scripts/leakage.py"
+
+
+# what single physical features could reach per fault class, whatever the detector
+rule ceiling:
+    input:
+        manifest="results/flights.csv",
+        cache="results/cache",
+    output:
+        csv="results/tables/ceiling.csv",
+        md="results/tables/ceiling.md",
+        html=report("results/tables/ceiling.html", caption="../report/ceiling.rst",
+                    category="Comparison"),
+    params:
+        subsets=SUBSETS,
+        deadline_s=config["scoring"]["deadline_s"],
+        margin_s=config["calibration"]["margin_s"],
+    log:
+        "results/logs/ceiling.log",
+    script:
+        "../scripts/ceiling.py"
