@@ -8,7 +8,8 @@ with the highest score-to-threshold ratio names the measured signal it scores
 (:func:`measured_sensor`). For ALFA's actuator faults, the sensor names the control
 axis it measures and so the actuator class that acts on that axis first
 (:data:`SENSOR_ACTUATOR`): roll → aileron, pitch → elevator, yaw and lateral specific
-force → rudder, airspeed and longitudinal specific force → engine. A flight with no
+force → rudder, airspeed, longitudinal specific force, climb rate and height →
+engine. A flight with no
 alarm from the onset on is ``missed``. Isolation is judged
 on the response to the fault alone: a false alarm before the onset is counted by the
 detection scores, not here.
@@ -35,7 +36,8 @@ _ACTUATORS = ["engine", "aileron", "elevator", "rudder"]
 MISSED = "missed"
 SENSOR_ACTUATOR = {"roll": "aileron", "roll_rate": "aileron", "pitch": "elevator",
                    "pitch_rate": "elevator", "yaw": "rudder", "yaw_rate": "rudder",
-                   "airspeed": "engine", "accel_x": "engine", "accel_y": "rudder"}
+                   "airspeed": "engine", "accel_x": "engine", "accel_y": "rudder",
+                   "vel_up": "engine", "rel_alt": "engine"}
 
 
 def measured_sensor(signal: str) -> str:

@@ -42,6 +42,7 @@ BUILTIN_ENTRIES = {
     "kalman_okid": "kalman_okid:KalmanOkid",
     "residual_bank": "residual_bank:ResidualBank",
     "learned_fusion": "learned_fusion:LearnedFusion",
+    "nested_selection": "nested_selection:NestedSelection",
     "emulation_oracle": "emulation_oracle:EmulationOracle",
     "end_of_flight": "end_of_flight:EndOfFlight",
 }

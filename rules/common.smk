@@ -44,8 +44,11 @@ for _name, _spec in config["methods"].items():
 
 def detector_code(method):
     """The source files of the modules ``method``'s detector runs on: a job's input, so
-    that a changed module re-runs the jobs of the detectors that use it, and no other."""
-    return module_sources(REGISTRY[config["methods"][method]["detector"]])
+    that a changed module re-runs the jobs of the detectors that use it, and no other.
+    A detector that wraps another (nested selection: ``params.detector``) runs on both."""
+    spec = config["methods"][method]
+    names = [spec["detector"], (spec.get("params") or {}).get("detector")]
+    return sorted({f for n in names if n in REGISTRY for f in module_sources(REGISTRY[n])})
 
 
 @functools.cache

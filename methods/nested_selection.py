@@ -1,0 +1,223 @@
+r"""Hyper-parameters chosen by an inner leave-one-date-out, inside each fit.
+
+A registered detector (``detector``, with fixed ``params``) has a ``grid`` of
+candidate values for some of its hyper-parameters; their product is the set of
+:math:`C` candidate configurations. The workflow fits this detector once per scored
+date, on labelled flights of the other dates only (:class:`~.base.Labelled`, so it is
+``supervised``: it reads their labels to score the candidates). Inside that fit, for
+each candidate :math:`c` and each training date :math:`d`, the base detector with
+:math:`c` is fitted on the fault-free data of the training dates other than
+:math:`d` (whole fault-free flights, the others up to onset less ``margin_s``) and run
+on the flights of :math:`d`. Each held-out flight counts as right when
+
+- a fault flight's first alarm lies in :math:`[\tau, \tau + D]` (``deadline_s``), the
+  primary scoring rule;
+- a fault-free flight never alarms;
+
+and :math:`c` scores the share of held-out flights it gets right, pooled over the
+training dates. Flights flown on an emergency trajectory are left out of the inner
+scores with ``score_emr`` False (the headline subset's rule; they still calibrate).
+The highest share wins, ties to the first candidate in grid order; the base detector
+with it is then fitted on the fault-free data of every training flight and scores the
+held-out date. So the scored date reaches neither the choice nor the fit, and the
+records say, per fold, which configuration scored and how many were tried
+(:meth:`NestedSelection.fitted`).
+
+Every candidate must read the same signals and give the same channels; a grid that
+changes them (a different set of models) is refused.
+"""
+
+from __future__ import annotations
+
+import itertools
+import logging
+import math
+
+import numpy as np
+
+from alfa_bench.data import Sampled
+from alfa_bench.data.flight import parse_flight_name
+
+from .base import Detector, Labelled
+
+__all__ = ["NestedSelection", "held_out_right"]
+
+log = logging.getLogger(__name__)
+
+
+def held_out_right(first_alarm_s: float | None, onset_s: float | None,
+                   deadline_s: float) -> bool:
+    """Whether a flight is scored right: a fault's first alarm within the deadline after
+    onset, no alarm on a fault-free flight."""
+    if onset_s is None:
+        return first_alarm_s is None
+    return first_alarm_s is not None and onset_s <= first_alarm_s <= onset_s + deadline_s
+
+
+class NestedSelection(Detector):
+    """A registered detector with hyper-parameters chosen by an inner
+    leave-one-date-out (module docstring).
+
+    Parameters
+    ----------
+    detector : str
+        The base detector's registry name.
+    params : dict
+        Its fixed hyper-parameters.
+    grid : dict of str to list
+        Candidate values per hyper-parameter; every combination is tried.
+    deadline_s : float
+        :math:`D` of the inner score.
+    margin_s : float
+        Fault-free data of a faulty flight ends this long before onset.
+    score_emr : bool
+        Whether flights on an emergency trajectory count in the inner scores.
+
+    Attributes
+    ----------
+    chosen_ : dict
+        The winning values of the grid's hyper-parameters.
+    inner_ : list of dict
+        Per candidate: its values, the held-out flights scored and how many were right.
+    base_ : Detector
+        The base detector with ``chosen_``, fitted on every training flight.
+    """
+
+    calibrated = True
+    supervised = True
+
+    def __init__(self, detector="residual_bank", params=None, grid=None, deadline_s=5.0,
+                 margin_s=1.0, score_emr=False):
+        self.detector = detector
+        self.params = params
+        self.grid = grid
+        self.deadline_s = deadline_s
+        self.margin_s = margin_s
+        self.score_emr = score_emr
+
+    # -- the base detector and its candidates -------------------------------------------
+
+    def _make(self, values: dict) -> Detector:
+        from . import make_detector  # the registry imports this module
+
+        return make_detector(self.detector, {**(self.params or {}), **values})
+
+    def candidates(self) -> list[dict]:
+        """Every combination of the grid's values, in grid order."""
+        grid = self.grid or {}
+        names = list(grid)
+        return [dict(zip(names, combo, strict=True))
+                for combo in itertools.product(*(grid[n] for n in names))]
+
+    def _reference(self) -> Detector:
+        """The base with the first candidate: what every candidate must agree with."""
+        return self._make(self.candidates()[0])
+
+    @property
+    def rate_hz(self) -> float:
+        return self._reference().rate_hz
+
+    @property
+    def causal(self) -> bool:
+        return self._reference().causal
+
+    def signals(self) -> tuple[str, ...]:
+        return self._reference().signals()
+
+    def channels(self) -> tuple[str, ...]:
+        return self._reference().channels()
+
+    def channel_outputs(self) -> tuple[str, ...]:
+        return self._reference().channel_outputs()
+
+    def _check_grid(self) -> list[Detector]:
+        candidates = self.candidates()
+        if not candidates:
+            raise ValueError("nested selection needs at least one candidate in its grid")
+        made = [self._make(c) for c in candidates]
+        if made[0].supervised:
+            raise ValueError(f"the base detector {self.detector!r} is supervised: nested "
+                             "selection fits its candidates on fault-free data")
+        for c, d in zip(candidates, made, strict=True):
+            if (d.signals(), d.channels(), d.rate_hz) != (made[0].signals(), made[0].channels(),
+                                                          made[0].rate_hz):
+                raise ValueError(f"candidate {c} changes the signals, channels or rate of "
+                                 f"{self.detector!r}: a grid may only tune, not reshape")
+        return made
+
+    # -- fitting ------------------------------------------------------------------------
+
+    def _free(self, flights: list[Labelled]) -> list[Sampled]:
+        """The fault-free segments of ``flights``, as the workflow calibrates."""
+        out = []
+        for f in flights:
+            s = f.sampled if f.onset_s is None else f.sampled.before(f.onset_s - self.margin_s)
+            if s.t.size:
+                out.append(s)
+        return out
+
+    def _scored(self, flight: Labelled) -> bool:
+        return self.score_emr or not str(
+            parse_flight_name(flight.flight)["label"]).endswith("with_emr_traj")
+
+    def fit(self, segments: list[Labelled]) -> NestedSelection:
+        for attr in ("chosen_", "inner_", "base_"):
+            self.__dict__.pop(attr, None)
+        made = self._check_grid()
+        date = [str(parse_flight_name(f.flight)["date"]) for f in segments]
+        dates = list(dict.fromkeys(date))
+        if len(dates) < 2:
+            raise ValueError(f"nested selection needs training flights of two dates or more; "
+                             f"found {len(dates)}")
+        inner = []
+        for values, det in zip(self.candidates(), made, strict=True):
+            right = scored = 0
+            for d in dates:
+                held = [f for f, fd in zip(segments, date, strict=True)
+                        if fd == d and self._scored(f)]
+                if not held:
+                    continue
+                det.fit(self._free([f for f, fd in zip(segments, date, strict=True) if fd != d]))
+                for f in held:
+                    score, _ = det.run(f.sampled)
+                    alarm = det.alarms(score).any(axis=1)
+                    first = float(f.t[np.argmax(alarm)]) if alarm.any() else None
+                    right += held_out_right(first, f.onset_s, self.deadline_s)
+                    scored += 1
+            inner.append({"values": values, "scored": scored, "right": right,
+                          "share": right / scored if scored else math.nan})
+        best = max(range(len(inner)), key=lambda i: (np.nan_to_num(inner[i]["share"], nan=-1.0),
+                                                    -i))
+        self.inner_ = inner
+        self.chosen_ = inner[best]["values"]
+        self.base_ = made[best].fit(self._free(segments))
+        log.info("nested selection of %s: %s, %d of %d held-out flights right (of %d "
+                 "candidates)", self.detector, self.chosen_, inner[best]["right"],
+                 inner[best]["scored"], len(inner))
+        return self
+
+    def fitted(self) -> dict:
+        self._check_fitted("base_")
+        return {"chosen": self.chosen_, "candidates": len(self.inner_), "inner": self.inner_,
+                "base": self.base_.fitted()}
+
+    # -- running: the fitted base --------------------------------------------------------
+
+    def thresholds(self) -> np.ndarray:
+        self._check_fitted("base_")
+        return self.base_.thresholds()
+
+    def probes(self) -> dict[str, float]:
+        return self.base_.probes() if hasattr(self, "base_") else self._reference().probes()
+
+    def reset(self) -> NestedSelection:
+        self._check_fitted("base_")
+        self.base_.reset()
+        return self
+
+    def update(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:
+        return self.base_.update(x, fresh)
+
+    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
+        self._check_fitted("base_")
+        return self.base_.run(s, probes)
