@@ -43,6 +43,7 @@ BUILTIN_ENTRIES = {
     "residual_bank": "residual_bank:ResidualBank",
     "learned_fusion": "learned_fusion:LearnedFusion",
     "nested_selection": "nested_selection:NestedSelection",
+    "coincidence": "coincidence:Coincidence",
     "emulation_oracle": "emulation_oracle:EmulationOracle",
     "end_of_flight": "end_of_flight:EndOfFlight",
 }

@@ -5,16 +5,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from alfa_bench.analysis.ceiling import (
-    FEATURES,
-    WARMUP_S,
-    auc_interval,
-    ceiling_markdown,
-    ceiling_table,
-    features,
-)
+from alfa_bench.analysis.ceiling import auc_interval, ceiling_markdown, ceiling_table
 from alfa_bench.data import load_flight
 from alfa_bench.data.synthetic import write_flight
+from alfa_bench.methods.physics import FEATURES, WARMUP_S, features
 
 
 def test_auc_counts_pairs_and_ties():
