@@ -32,7 +32,11 @@ sensor faults: ``sensorfaults`` (injected flights scored), ``sensordetected:<m>`
 ``bestsensor`` (the run whose detection rate beats its chance rate by most),
 ``sensorisolated:<m>`` (sensor named correctly, % of the injected faults) and
 ``actuatorisolated:<m>`` (actuator class named correctly, % of ALFA's fault flights),
-``paper:precision``,
+``configurations:<m>`` (the configurations the run scored to choose each fold's: the
+candidates of a nested selection, else 1); from the detectability ceiling
+(:mod:`.ceiling`): ``ceilingfeature:<s>:<c>``, ``ceilingauc:<s>:<c>`` and
+``ceilingreach:<s>:<c>`` (the best single feature of class ``c``, its AUC, and "k of n"
+faults above every fault-free maximum); ``paper:precision``,
 ``paper:recall``, ``paper:accuracy``, ``paper:meandet``, ``paper:maxdet`` (Keipour et
 al. 2019, quoted).
 """
@@ -77,12 +81,13 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.Dat
                   by_fault: pd.DataFrame | None = None,
                   per_flight: pd.DataFrame | None = None,
                   methods=(), subsets=(), sensors: dict | None = None,
-                  primary: str | None = None) -> dict[str, str]:
+                  primary: str | None = None,
+                  ceiling: pd.DataFrame | None = None) -> dict[str, str]:
     """Every quotable number, as text, by key (see the module docstring). A configured
     run (``methods``) with no score on a subset (``subsets``), because every flight of
     it was excluded, quotes "n/a". ``sensors`` holds the ``detectability``,
     ``isolation_sensors`` and ``isolation_actuators`` tables; ``primary`` is the
-    headline subset."""
+    headline subset; ``ceiling`` the detectability ceiling's table."""
     out = {f"{k}:{m}:{s}": "n/a" for k in _PER_RUN for m in methods for s in subsets}
     out |= {f"paper:{k}": (_pct if k in ("precision", "recall", "accuracy") else _sec)(
         ICRA2019_SUMMARY[key])
@@ -121,6 +126,11 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.Dat
         out[f"recallnofa:{m}:{s}"] = _pct(clean["recall"].max()) if len(clean) else "n/a"
     out |= _leak_numbers(leakage)
     runs = [*dict.fromkeys([*methods, *comparison["method"]])]
+    out |= {f"configurations:{m}": "n/a" for m in runs}
+    if "configurations" in comparison:
+        for m, n in comparison.groupby("method")["configurations"].max().items():
+            out[f"configurations:{m}"] = str(int(n))
+    out |= _ceiling_numbers(ceiling, [*dict.fromkeys([*subsets, *comparison["subset"]])])
     # every run, subset and class first, so that a flight set without some still renders
     out |= {f"classdetected:{m}:{s}:{c}": "n/a" for m in runs
             for s in [*dict.fromkeys([*subsets, *comparison["subset"]])]
@@ -142,6 +152,22 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.Dat
             if rows["margin_before"].notna().any():
                 out[f"marginbefore:{m}"] = f"{rows['margin_before'].max():.2f}"
     return out | sensor_numbers(sensors or {}, runs)
+
+
+def _ceiling_numbers(ceiling: pd.DataFrame | None, subsets) -> dict[str, str]:
+    """The best single feature per subset and class, "n/a" where the table has none."""
+    classes = [c for c in FAULT_ORDER if c != "none"]
+    out = {f"{k}:{s}:{c}": "n/a" for k in ("ceilingfeature", "ceilingauc", "ceilingreach")
+           for s in subsets for c in classes}
+    if ceiling is None or ceiling.empty:
+        return out
+    best = ceiling[ceiling["best"].astype(str).str.lower() == "true"]
+    for r in best.drop_duplicates(["subset", "fault_class"]).to_dict(orient="records"):
+        key = f"{r['subset']}:{r['fault_class']}"
+        out[f"ceilingfeature:{key}"] = str(r["feature"])
+        out[f"ceilingauc:{key}"] = f"{r['auc']:.2f}"
+        out[f"ceilingreach:{key}"] = f"{r['above_free_max']} of {r['fault_flights']}"
+    return out
 
 
 def _leak_numbers(leakage: pd.DataFrame) -> dict[str, str]:

@@ -40,8 +40,8 @@ from .scoring import mcnemar_exact, score_records
 
 __all__ = ["BLOCKS", "BLOCK_MARKS", "FAULT_ORDER", "SIGNIFICANCE", "block", "by_fault_latex",
            "by_fault_markdown", "by_fault_table", "comparison_latex", "comparison_markdown",
-           "comparison_notes", "comparison_table", "failures_table", "summary_latex",
-           "summary_markdown", "summary_table", "unscored_notes"]
+           "comparison_notes", "comparison_table", "configurations", "failures_table",
+           "summary_latex", "summary_markdown", "summary_table", "unscored_notes"]
 
 #: ALFA's fault classes in the tables' order (the injected sensor faults are scored apart)
 FAULT_ORDER = tuple(c for c in FAULT_CLASSES if c != "sensor")
@@ -131,7 +131,18 @@ def _calibration(rec: dict) -> str:
     if not cal:
         return "none"
     data = "supervised (labelled flights)" if cal.get("supervised") else "fault-free only"
-    return f"{data}, leave-one-{cal['group_by']}-out"
+    n = configurations(rec)
+    chosen = (f"; best of {n} configurations by an inner leave-one-{cal['group_by']}-out"
+              if n > 1 else "")
+    return f"{data}, leave-one-{cal['group_by']}-out{chosen}"
+
+
+def configurations(rec: dict) -> int:
+    """How many configurations the run scored to choose the one that scored ``rec``: the
+    candidates of a nested selection (:mod:`alfa_bench.methods.nested_selection`),
+    else one."""
+    fitted = (rec.get("calibration") or {}).get("fitted") or {}
+    return int(fitted.get("candidates", 1)) if isinstance(fitted, dict) else 1
 
 
 def _isolation(recs: list[dict], outcomes: list[str]) -> tuple[int, int]:
@@ -165,6 +176,7 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
             runs.append((correct, {
                 "subset": subset, "method": method, "block": block(recs[0]),
                 "detector": recs[0]["detector"], "calibration": _calibration(recs[0]),
+                "configurations": max(configurations(r) for r in recs),
                 "deadline_s": deadline_s, **s,
                 "fault_free_flights": len(free),
                 "fault_free_false_alarms": sum(r["first_alarm_s"] is not None for r in free),

@@ -42,7 +42,8 @@ import numpy as np
 from alfa_bench.data import Flight, Sampled, not_measured, sample
 
 __all__ = ["Detector", "Labelled", "NotFittedError", "PairDetector", "Trace",
-           "fault_free_segments", "labelled_segments", "run_detector", "skipped_channels"]
+           "fault_free_segments", "labelled_segments", "run_detector", "skipped_channels",
+           "training_segments"]
 
 log = logging.getLogger(__name__)
 
@@ -320,3 +321,13 @@ def labelled_segments(detector: Detector, flights: list[Flight]) -> list[Labelle
         segments.append(Labelled(sample(flight, detector.signals(), detector.rate_hz),
                                  flight.fault.onset_s, flight.fault.fault_class))
     return segments
+
+
+def training_segments(detector: Detector, flights: list[Flight],
+                      margin_s: float) -> list[Sampled] | list[Labelled]:
+    """What ``detector``'s :meth:`~Detector.fit` takes from ``flights``: their
+    :func:`labelled_segments` if it is supervised, else their
+    :func:`fault_free_segments`."""
+    if detector.supervised:
+        return labelled_segments(detector, flights)
+    return fault_free_segments(detector, flights, margin_s)

@@ -42,9 +42,8 @@ from alfa_bench.data.synthetic import write_corpus
 from .base import (
     Detector,
     NotFittedError,
-    fault_free_segments,
-    labelled_segments,
     run_detector,
+    training_segments,
 )
 
 __all__ = ["CHECKS", "parametrize_with_checks"]
@@ -63,8 +62,7 @@ def _corpus() -> Path:
 
 def _fit(detector: Detector) -> Detector:
     training = [load_flight(p) for p in sorted(_corpus().iterdir())]
-    return detector.fit(labelled_segments(detector, training) if detector.supervised
-                        else fault_free_segments(detector, training, margin_s=1.0))
+    return detector.fit(training_segments(detector, training, margin_s=1.0))
 
 
 _FITTED: dict = {}

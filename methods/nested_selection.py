@@ -15,7 +15,8 @@ on the flights of :math:`d`. Each held-out flight counts as right when
 - a fault-free flight never alarms;
 
 and :math:`c` scores the share of held-out flights it gets right, pooled over the
-training dates. Flights flown on an emergency trajectory are left out of the inner
+training dates (a date without which :math:`c` cannot be fitted goes unscored, and is
+named). Flights flown on an emergency trajectory are left out of the inner
 scores with ``score_emr`` False (the headline subset's rule; they still calibrate).
 The highest share wins, ties to the first candidate in grid order; the base detector
 with it is then fitted on the fault-free data of every training flight and scores the
@@ -78,7 +79,8 @@ class NestedSelection(Detector):
     chosen_ : dict
         The winning values of the grid's hyper-parameters.
     inner_ : list of dict
-        Per candidate: its values, the held-out flights scored and how many were right.
+        Per candidate: its values, the held-out flights scored, how many were right, and
+        the training dates without which it could not be fitted.
     base_ : Detector
         The base detector with ``chosen_``, fitted on every training flight.
     """
@@ -172,12 +174,20 @@ class NestedSelection(Detector):
         inner = []
         for values, det in zip(self.candidates(), made, strict=True):
             right = scored = 0
+            unfit = []
             for d in dates:
                 held = [f for f, fd in zip(segments, date, strict=True)
                         if fd == d and self._scored(f)]
                 if not held:
                     continue
-                det.fit(self._free([f for f, fd in zip(segments, date, strict=True) if fd != d]))
+                try:
+                    det.fit(self._free([f for f, fd in zip(segments, date, strict=True)
+                                        if fd != d]))
+                except ValueError as e:       # too little data without d: d goes unscored
+                    log.info("nested selection: %s cannot be fitted without %s: %s",
+                             values, d, e)
+                    unfit.append(d)
+                    continue
                 for f in held:
                     score, _ = det.run(f.sampled)
                     alarm = det.alarms(score).any(axis=1)
@@ -185,7 +195,10 @@ class NestedSelection(Detector):
                     right += held_out_right(first, f.onset_s, self.deadline_s)
                     scored += 1
             inner.append({"values": values, "scored": scored, "right": right,
-                          "share": right / scored if scored else math.nan})
+                          "share": right / scored if scored else math.nan, "unfit": unfit})
+        if not any(c["scored"] for c in inner):
+            raise ValueError(f"nested selection of {self.detector!r}: no candidate could be "
+                             "fitted and scored on any training date")
         best = max(range(len(inner)), key=lambda i: (np.nan_to_num(inner[i]["share"], nan=-1.0),
                                                     -i))
         self.inner_ = inner

@@ -27,6 +27,7 @@ rule paper_sources:
         isolation_actuators="results/tables/isolation_actuators.csv",
         sweep="results/tables/sweep.csv",
         leakage="results/tables/leakage.csv",
+        ceiling="results/tables/ceiling.csv",
         tex=PAPER_DIR / "paper.tex",
         markdown=PAPER_DIR / "paper.template.md",
     output:

@@ -95,7 +95,9 @@ def test_no_fit_of_a_configured_run_sees_the_date_it_scores(run, corpus_flights,
     records = [r for r, _ in detect_all(run, spec, corpus_flights, corpus_manifest, CALIBRATION)]
     assert records and len(seen) == len({r["calibration"]["fold"] for r in records})
     assert_held_out(records, seen, corpus_manifest)
-    assert not any(r["calibration"]["supervised"] for r in records)
+    # only a run that declares it learns from labels (a nested selection) gets them
+    assert all(r["calibration"]["supervised"] == REGISTRY[spec["detector"]].supervised
+               for r in records)
 
 
 def test_a_supervised_detector_learns_from_labelled_flights_of_other_dates(

@@ -12,7 +12,7 @@ import pytest
 import yaml
 
 from alfa_bench.data import SIGNALS, Signal, Topic, load_flight, reads_actuators
-from alfa_bench.methods import REGISTRY, fault_free_segments, make_detector, run_detector
+from alfa_bench.methods import REGISTRY, make_detector, run_detector, training_segments
 
 CONFIG = yaml.safe_load((Path(__file__).parent.parent / "config/config.yaml").read_text())
 RUNS = {name: spec for name, spec in CONFIG["methods"].items()}
@@ -35,7 +35,7 @@ def columns_read(detector, corpus: Path, flight: Path, monkeypatch) -> set[tuple
 
     monkeypatch.setattr(Topic, "values", spy)
     if detector.calibrated:
-        detector.fit(fault_free_segments(
+        detector.fit(training_segments(
             detector, [load_flight(p) for p in sorted(corpus.iterdir())], margin_s=1.0))
     run_detector(detector, load_flight(flight))
     return seen

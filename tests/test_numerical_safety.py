@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from alfa_bench.data import Sampled, load_flight, sample
-from alfa_bench.methods import REGISTRY, fault_free_segments, make_detector
+from alfa_bench.methods import REGISTRY, fault_free_segments, make_detector, training_segments
 from alfa_bench.methods.rls import RecursiveLeastSquares
 
 
@@ -69,7 +69,7 @@ def fitted(corpus):
     for name in REGISTRY:
         det = make_detector(name)
         if det.calibrated:
-            det.fit(fault_free_segments(det, flights, margin_s=1.0))
+            det.fit(training_segments(det, flights, margin_s=1.0))
         out[name] = (det, sample(scored, det.signals(), det.rate_hz))
     return out
 
