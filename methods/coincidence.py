@@ -47,8 +47,9 @@ import numpy as np
 from alfa_bench.data import Sampled
 
 from .base import Detector
+from .extremes import gumbel_threshold
 from .physics import FEATURE_SIGNAL, FEATURES, HISTORY_S, RATE_HZ, SIGNALS_READ, features_of
-from .residual_bank import gumbel_threshold, window_steps
+from .windows import window_steps
 
 __all__ = ["Coincidence", "DEFAULT_SIGNATURES"]
 

@@ -44,7 +44,8 @@ import numpy as np
 from alfa_bench.data import Sampled
 
 from .base import Detector
-from .residual_bank import DEFAULT_MODELS, MIN_SEGMENTS, ResidualBank, gumbel_threshold
+from .extremes import gumbel_threshold
+from .residual_bank import DEFAULT_MODELS, MIN_SEGMENTS, ResidualBank
 
 __all__ = ["LearnedFusion"]
 

@@ -21,7 +21,7 @@ import numpy as np
 
 from alfa_bench.data import Flight, Sampled, sample
 
-from .residual_bank import step_means, window_steps
+from .windows import step_means, window_steps
 
 __all__ = ["BASELINE_S", "FEATURES", "FEATURE_SIGNAL", "HISTORY_S", "RATE_HZ", "SIGNALS_READ",
            "WARMUP_S", "features", "features_of"]

@@ -36,7 +36,7 @@ Thresholds count false alarms per flight, not per sample. For each channel the
 maxima :math:`M_{c,j} = \max_t s_c(t)` over the fault-free training segments
 :math:`j` (whole fault-free flights, and the others up to onset) are fitted with a
 Gumbel law, each capped first so that one extreme flight moves it little
-(:func:`gumbel_threshold`), and
+(:func:`~.extremes.gumbel_threshold`), and
 
 .. math::
 
@@ -94,9 +94,10 @@ import numpy as np
 from alfa_bench.data import SIGNALS, Sampled
 
 from .base import Detector
+from .extremes import gumbel_threshold
+from .windows import step_from_sums, step_means, window_steps
 
-__all__ = ["DEFAULT_MODELS", "ResidualBank", "gumbel_threshold", "regressor_signal",
-           "step_means", "window_steps"]
+__all__ = ["DEFAULT_MODELS", "ResidualBank", "regressor_signal"]
 
 #: One model per physical signature (module docstring): name, output, regressors and
 #: whether only a drop of the output is a fault.
@@ -119,9 +120,6 @@ _REGRESSOR = re.compile(r"^(?:(sin|tan|sq)\()?([a-z_]+)\)?$")
 
 #: fewer per-flight maxima than this cannot fit a two-parameter law
 MIN_SEGMENTS = 3
-#: per-flight maxima are capped at this quantile of the law their quartiles give
-#: (:func:`gumbel_threshold`): one fault-free flight in a thousand would exceed it
-CAP_LEVEL = 0.999
 
 
 @cache          # parsed once per name, not at every streaming step
@@ -132,39 +130,6 @@ def regressor_signal(regressor: str) -> tuple[str | None, str]:
         raise ValueError(f"regressor {regressor!r} is not a signal name of "
                          "alfa_bench.data.SIGNALS, bare or as sin(.), tan(.) or sq(.)")
     return m.group(1), m.group(2)
-
-
-def window_steps(seconds: float, rate_hz: float) -> int:
-    """A span of ``seconds`` in grid steps, at least one."""
-    return max(1, round(seconds * rate_hz))
-
-
-def _gumbel_unit(p: float) -> float:
-    """The Gumbel law's quantile function in units of its scale: Q(p) = mu + beta g(p)."""
-    return -math.log(-math.log(p))
-
-
-def gumbel_threshold(maxima: np.ndarray, level: float) -> float:
-    r"""The ``level`` quantile of a Gumbel law fitted (maximum likelihood) to the
-    per-flight ``maxima``, each capped first so that one extreme flight cannot move it
-    far. The cap is the :data:`CAP_LEVEL` quantile of the law fitted by the quartiles
-    :math:`q_p`, which one flight moves by at most one order statistic:
-
-    .. math::
-
-        \mathrm{cap} = q_{1/2} + (q_{3/4} - q_{1/4})\,
-        \frac{g(p_{\mathrm{cap}}) - g(1/2)}{g(3/4) - g(1/4)}, \qquad g(p) = -\ln(-\ln p).
-
-    Maxima like the others lie far below it, and are fitted as they are; an absurd one
-    weighs as a flight at the cap does."""
-    from scipy import stats  # ~0.5 s to import: only where a Gumbel law is fitted
-
-    maxima = np.asarray(maxima, dtype=float)
-    q1, q2, q3 = np.quantile(maxima, [0.25, 0.5, 0.75])
-    cap = q2 + (q3 - q1) * (_gumbel_unit(CAP_LEVEL) - _gumbel_unit(0.5)) / (
-        _gumbel_unit(0.75) - _gumbel_unit(0.25))
-    loc, scale = stats.gumbel_r.fit(np.minimum(maxima, cap))
-    return float(stats.gumbel_r.ppf(level, loc, scale))
 
 
 class ResidualBank(Detector):
@@ -400,7 +365,8 @@ class ResidualBank(Detector):
         d = np.full(len(self.models), np.nan)
         if h["k"] >= span:
             at = [(h["k"] - back) % (span + 1) for back in (0, h["nw"], span)]
-            d = _step(*(h["total"][i] for i in at), *(h["count"][i] for i in at)) / h["sigma"]
+            d = step_from_sums(*(h["total"][i] for i in at),
+                               *(h["count"][i] for i in at)) / h["sigma"]
         self.last_ = {"prediction": pred, "residual": res, "step": d}
         return self.scores(d)
 
@@ -421,29 +387,3 @@ class ResidualBank(Detector):
                 kept.update({f"{m['name']}/prediction": pred[:, c],
                              f"{m['name']}/residual": res[:, c], f"{m['name']}/step": d[:, c]})
         return score, kept
-
-
-def step_means(values: np.ndarray, have: np.ndarray, nw: int, nb: int) -> np.ndarray:
-    """The window difference of (2), unscaled, at every step: the mean of the rows of
-    ``values`` (n, p) marked ``have`` over the last ``nw`` steps minus their mean over
-    the ``nb`` steps before; NaN where either window holds none. ``have`` is (n,) or
-    (n, p)."""
-    have = np.broadcast_to(have.reshape(have.shape[0], -1), values.shape)
-    total = np.cumsum(np.where(have, values, 0.0), axis=0)
-    count = np.cumsum(have, axis=0)
-    n = values.shape[0]
-    out = np.full(values.shape, np.nan)
-    if n > nw + nb:
-        out[nw + nb:] = _step(total[nw + nb:], total[nb:n - nw], total[:n - nw - nb],
-                              count[nw + nb:], count[nb:n - nw], count[:n - nw - nb])
-    return out
-
-
-def _step(total_now, total_mid, total_old, count_now, count_mid, count_old):
-    """The difference of (2), unscaled, from cumulative sums and counts at t, t - W and
-    t - W - B; NaN where a window holds no fresh value."""
-    n_recent, n_base = count_now - count_mid, count_mid - count_old
-    with np.errstate(invalid="ignore", divide="ignore"):
-        recent = (total_now - total_mid) / n_recent                # mean over (t - W, t]
-        base = (total_mid - total_old) / n_base                    # mean over (t - W - B, t - W]
-    return np.where((n_recent > 0) & (n_base > 0), recent - base, np.nan)

@@ -17,7 +17,7 @@ from alfa_bench.data.inject import InjectedGrid
 from alfa_bench.data.manifest import manifest_of, manifest_row
 from alfa_bench.data.synthetic import write_flight
 from alfa_bench.methods import make_detector, run_detector
-from alfa_bench.methods.residual_bank import CAP_LEVEL, gumbel_threshold
+from alfa_bench.methods.extremes import CAP_LEVEL, gumbel_threshold
 
 FREE = "carbonZ_2018-07-18-16-37-39_1_no_failure"
 ENGINE = "carbonZ_2018-07-18-15-53-31_1_engine_failure"

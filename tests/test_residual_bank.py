@@ -10,7 +10,8 @@ import pytest
 
 from alfa_bench.data import Sampled
 from alfa_bench.methods import make_detector, run_detector
-from alfa_bench.methods.residual_bank import DEFAULT_MODELS, ResidualBank, step_means
+from alfa_bench.methods.residual_bank import DEFAULT_MODELS, ResidualBank
+from alfa_bench.methods.windows import step_means
 
 RATE_HZ = 20.0
 
