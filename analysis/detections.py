@@ -33,8 +33,10 @@ from alfa_bench.data import (
 )
 from alfa_bench.methods import (
     Detector,
+    Fork,
     Trace,
     fault_free_segments,
+    forks,
     labelled_segments,
     make_detector,
     run_detector,
@@ -73,7 +75,8 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
     train = manifest if calibrate_on is None else calibrate_on
     sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
     sha |= dict(zip(train["flight"], train["sha256"], strict=True))
-    scorer = _Scorer(method, spec, detector, flights, sha, calibration, failures)
+    scorer = _Scorer(method, spec, detector, flights, sha, calibration, failures,
+                     _sources(manifest))
     if not detector.calibrated:
         for name in manifest.loc[manifest["ground_truth"], "flight"]:
             if (out := scorer.record(name)) is not None:
@@ -105,19 +108,36 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
                                        f"{sorted(scored_by_fold)}"))
 
 
+def _sources(manifest: pd.DataFrame) -> dict[str, tuple[str, list[float]]]:
+    """Per injected flight of ``manifest`` (``fault_source`` set), its source flight
+    and the onsets of every flight injected into that source: where runs fork."""
+    if "fault_source" not in manifest:
+        return {}
+    injected = manifest[manifest["fault_source"].fillna("").astype(str) != ""]
+    onsets = injected.groupby("fault_source")["onset_s"].agg(lambda v: sorted(set(v)))
+    return {f: (s, onsets[s]) for f, s in zip(injected["flight"], injected["fault_source"],
+                                               strict=True)}
+
+
 class _Scorer:
     """One method's run over flights: each flight's record, made once; a flight's bad
     data turned into a failure row (or raised, with ``failures`` None), after which the
     flight is neither scored nor calibrates; and a fold it cannot calibrate turned into
-    failure rows for the flights that fold scores."""
+    failure rows for the flights that fold scores.
+
+    An injected flight is its source up to its onset, so the fitted detector is run
+    over each source once per fold, up to every onset injected into it
+    (:func:`~alfa_bench.methods.forks`), and each injected flight continues from the
+    fork at its onset."""
 
     def __init__(self, method: str, spec: dict, detector: Detector,
                  flights: Mapping[str, Flight], sha: dict, calibration: dict,
-                 failures: list[dict] | None):
+                 failures: list[dict] | None, sources: dict[str, tuple[str, list[float]]]):
         self.method, self.spec, self.detector = method, spec, detector
         self.flights, self.sha, self.calibration = flights, sha, calibration
-        self.failures = failures
+        self.failures, self.sources = failures, sources
         self.failed: set[str] = set()
+        self.forks: dict[str, dict[float, Fork]] = {}
 
     def guarded(self, stage: str, name: str, fn):
         """``fn()``, or None once flight ``name`` has bad data (at ``stage``)."""
@@ -134,8 +154,16 @@ class _Scorer:
             return None
 
     def record(self, name: str, info: dict | None = None) -> tuple[dict, Trace] | None:
+        if name not in self.sources:
+            return self.guarded("detect", name, lambda: detection_record(
+                self.method, self.spec, self.detector, self.flights[name], self.sha, info))
+        source, onsets = self.sources[name]
+        if source not in self.forks:
+            self.forks[source] = self.guarded("detect", source, lambda: forks(
+                self.detector, self.flights[source], onsets)) or {}
         return self.guarded("detect", name, lambda: detection_record(
-            self.method, self.spec, self.detector, self.flights[name], self.sha, info))
+            self.method, self.spec, self.detector, self.flights[name], self.sha, info,
+            forked=self.forks[source]))
 
     def uncalibrated(self, names: list[str], error: ValueError) -> None:
         if self.failures is None:
@@ -161,6 +189,7 @@ class _Scorer:
         used = [f for f in readable if f not in dead]
         data = [s for f in used for s in segments[f]]
         check_held_out(data, fold, scored, group)
+        self.forks = {}                # run by the previous fold's fit
         try:
             detector.fit(data)
         except ValueError as e:
@@ -188,15 +217,23 @@ def calibration_failure(flight: str, method: str, error: ValueError, calibration
 
 
 def detection_record(method: str, spec: dict, detector: Detector, flight: Flight,
-                     sha256: dict[str, str], calibration: dict | None = None
-                     ) -> tuple[dict, Trace]:
+                     sha256: dict[str, str], calibration: dict | None = None,
+                     forked: dict[float, Fork] | None = None) -> tuple[dict, Trace]:
     """Run ``detector`` (fitted if calibrated) on ``flight``: its record and trace.
     ``sha256`` maps flights to their checksums; the record's provenance gives those of
-    ``flight`` and of the flights that calibrated the detector."""
+    ``flight`` and of the flights that calibrated the detector.
+
+    With ``forked`` (an injected flight: :func:`~alfa_bench.methods.forks` of its
+    source, by time), the run continues from the latest fork at or before the onset,
+    and keeps no probes (an injected flight has no trace written)."""
     if flight.fault is None:
         raise ValueError(f"flight {flight.id} has no ground truth and cannot be scored")
-    trace = run_detector(detector, flight, probes=True)
     onset = flight.fault.onset_s
+    if forked is None:
+        trace = run_detector(detector, flight, probes=True)
+    else:
+        at = max((t for t in forked if onset is not None and t <= onset), default=None)
+        trace = run_detector(detector, flight, fork=forked.get(at))
     first = trace.first_alarm_s()
     outputs = dict(zip(trace.channels, detector.channel_outputs(), strict=True))
     outcome = flight_outcome(onset, first)

@@ -205,6 +205,11 @@ class Sampled:
         return Sampled(t=self.t[:n], x=self.x[:n], fresh=self.fresh[:n], names=self.names,
                        flight=self.flight)
 
+    def since(self, k: int) -> Sampled:
+        """The grid steps from step ``k`` on."""
+        return Sampled(t=self.t[k:], x=self.x[k:], fresh=self.fresh[k:], names=self.names,
+                       flight=self.flight)
+
 
 def series(flight: Flight, name: str) -> tuple[np.ndarray, np.ndarray]:
     """Signal ``name`` of ``flight`` at its topic's record times: ``(t, value)``."""

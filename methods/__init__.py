@@ -15,20 +15,23 @@ from importlib.metadata import entry_points
 
 from .base import (
     Detector,
+    Fork,
     Labelled,
     NotFittedError,
     PairDetector,
     Trace,
     fault_free_segments,
+    forks,
     labelled_segments,
     run_detector,
     skipped_channels,
     training_segments,
 )
 
-__all__ = ["BUILTIN", "BUILTIN_ENTRIES", "PLUGIN_GROUP", "REGISTRY", "Detector", "Labelled",
-           "NotFittedError", "PairDetector", "Trace", "fault_free_segments", "labelled_segments",
-           "make_detector", "plugins", "run_detector", "skipped_channels", "training_segments"]
+__all__ = ["BUILTIN", "BUILTIN_ENTRIES", "PLUGIN_GROUP", "REGISTRY", "Detector", "Fork",
+           "Labelled", "NotFittedError", "PairDetector", "Trace", "fault_free_segments",
+           "forks", "labelled_segments", "make_detector", "plugins", "run_detector",
+           "skipped_channels", "training_segments"]
 
 #: the entry-point group third-party detectors register under
 PLUGIN_GROUP = "alfa_bench.methods"

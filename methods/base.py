@@ -10,6 +10,14 @@ re-running the detector. A flight alarms when any channel alarms.
 :meth:`Detector.probes` exposes the intermediates of the last step (prediction,
 residual, ...) for inspection.
 
+A run can be *forked*: :meth:`Detector.snapshot` copies the running state after the
+first :math:`k` steps of a flight, and ``run(s, start=k, state=...)`` continues any
+flight that shares those :math:`k` steps from it, as if it had been run from
+:math:`t = 0`. The injected sensor faults are their source flight, unchanged, up to
+the onset, so the steps before it are run once per source and onset
+(:func:`forks`), not once per injected flight. A detector whose :meth:`snapshot` is
+None is run from :math:`t = 0` instead.
+
 A *calibrated* detector also learns from fault-free data before it runs:
 :meth:`Detector.fit` takes fault-free segments (whole fault-free flights and the
 pre-fault parts of the others, never the flight to be scored) and sets its fitted
@@ -32,6 +40,7 @@ of calibration. Both are logged and recorded.
 
 from __future__ import annotations
 
+import copy
 import inspect
 import logging
 from abc import ABC, abstractmethod
@@ -41,9 +50,9 @@ import numpy as np
 
 from alfa_bench.data import Flight, Sampled, not_measured, sample
 
-__all__ = ["Detector", "Labelled", "NotFittedError", "PairDetector", "Trace",
-           "fault_free_segments", "labelled_segments", "run_detector", "skipped_channels",
-           "training_segments"]
+__all__ = ["Detector", "Fork", "Labelled", "NotFittedError", "PairDetector", "Trace",
+           "fault_free_segments", "forks", "labelled_segments", "run_detector",
+           "skipped_channels", "training_segments"]
 
 log = logging.getLogger(__name__)
 
@@ -125,18 +134,40 @@ class Detector(ABC):
         with np.errstate(invalid="ignore"):
             return np.asarray(score) > self.thresholds()
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
+    def snapshot(self) -> object | None:
+        """A copy of the running state after the last :meth:`run` or :meth:`update`,
+        for ``run(s, start=k, state=...)`` to continue from; None if the detector
+        cannot continue from a state (a forked run then runs from :math:`t = 0`).
+
+        By default a copy of the attributes where :meth:`run` is this class's, which
+        steps :meth:`update`, and None where a subclass overrides :meth:`run`: its
+        batch form must say itself how it continues (and the contract test checks
+        that it does so exactly)."""
+        if type(self).run is not Detector.run:
+            return None
+        return copy.deepcopy(vars(self))
+
+    def run(self, s: Sampled, probes: bool = False, start: int = 0,
+            state: object | None = None) -> tuple[np.ndarray, dict]:
         """:meth:`reset`, then :meth:`update` over every step of ``s``: scores, shape
         (n, c), and with ``probes`` the :meth:`probes` of every step. Detectors may
         override it with a batch form; it must give the same scores to rounding (the
-        contract test checks)."""
-        self.reset()
-        n, c = s.t.size, len(self.channels())
+        contract test checks).
+
+        With ``state``, a :meth:`snapshot` taken after running the first ``start``
+        steps of ``s``: no reset; the run continues from it over steps ``start:``, and
+        returns theirs only, shape (n - start, c)."""
+        if state is None:
+            self.reset()
+            start = 0
+        else:
+            self.__dict__.update(copy.deepcopy(state))
+        n, c = s.t.size - start, len(self.channels())
         score = np.empty((n, c))
         names = list(self.probes()) if probes else []
         kept = np.full((n, len(names)), np.nan)
         for k in range(n):
-            score[k] = self.update(s.x[k], s.fresh[k])
+            score[k] = self.update(s.x[start + k], s.fresh[start + k])
             if names:
                 kept[k] = list(self.probes().values())
         return score, {name: kept[:, i] for i, name in enumerate(names)}
@@ -264,12 +295,75 @@ def skipped_channels(detector: Detector, dead) -> dict[str, str]:
             if inputs or out in dead}
 
 
-def run_detector(detector: Detector, flight: Flight, probes: bool = False) -> Trace:
+@dataclass(frozen=True)
+class Fork:
+    """A detector's run over the first steps of a flight, for the flights that share
+    them to continue from (:func:`forks`, :func:`run_detector`).
+
+    Attributes
+    ----------
+    sampled : Sampled
+        The steps run.
+    state : object
+        :meth:`Detector.snapshot` after them.
+    score : ndarray, shape (k, c)
+    probes : dict of str to ndarray, shape (k,)
+        Empty unless the run kept them.
+    """
+
+    sampled: Sampled
+    state: object
+    score: np.ndarray
+    probes: dict
+
+    def shared_by(self, s: Sampled, probes: bool) -> bool:
+        """Whether ``s`` begins with exactly these steps (times, values, freshness), and
+        the fork kept the probes a run asks for."""
+        k = self.sampled.t.size
+        return (s.t.size >= k and (bool(self.probes) or not probes)
+                and np.array_equal(s.t[:k], self.sampled.t)
+                and np.array_equal(s.x[:k], self.sampled.x, equal_nan=True)
+                and np.array_equal(s.fresh[:k], self.sampled.fresh))
+
+
+def forks(detector: Detector, flight: Flight, times_s, probes: bool = False
+          ) -> dict[float, Fork]:
+    """``detector`` run over ``flight`` up to each of ``times_s`` (its grid steps before
+    each), each run continuing the one before: a :class:`Fork` per time. Empty when the
+    detector cannot fork (:meth:`Detector.snapshot` is None)."""
+    s = sample(flight, detector.signals(), detector.rate_hz)
+    out, state, score, kept = {}, None, np.empty((0, len(detector.channels()))), {}
+    for t_s in sorted(set(times_s)):
+        head = s.before(t_s)
+        done = score.shape[0]
+        more, more_kept = (detector.run(head, probes) if state is None else
+                           detector.run(head, probes, start=done, state=state))
+        score = np.vstack([score, more])
+        kept = {n: np.concatenate([kept.get(n, np.empty(0)), v]) for n, v in more_kept.items()}
+        state = detector.snapshot()
+        if state is None:
+            return {}
+        out[t_s] = Fork(head, state, score, kept)
+    return out
+
+
+def run_detector(detector: Detector, flight: Flight, probes: bool = False,
+                 fork: Fork | None = None) -> Trace:
     """Run ``detector`` causally over ``flight``, from a fresh state; with ``probes``,
     keep :meth:`Detector.probes` of every step. Channels on signals the flight does not
-    measure are skipped (:func:`skipped_channels`)."""
+    measure are skipped (:func:`skipped_channels`).
+
+    With ``fork``, a flight that begins with the fork's steps continues from its state
+    instead: the same trace, without running those steps again. One that does not (or
+    a fork without the probes asked for) runs from a fresh state."""
     s = sample(flight, detector.signals(), detector.rate_hz)
-    score, kept = detector.run(s, probes)
+    if fork is not None and fork.shared_by(s, probes):
+        k = fork.sampled.t.size
+        more, more_kept = detector.run(s, probes, start=k, state=fork.state)
+        score = np.vstack([fork.score, more])
+        kept = {n: np.concatenate([fork.probes[n], v]) for n, v in more_kept.items()}
+    else:
+        score, kept = detector.run(s, probes)
     skipped = skipped_channels(detector, not_measured(flight, detector.signals()))
     if skipped:
         score[:, [detector.channels().index(ch) for ch in skipped]] = np.nan

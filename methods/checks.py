@@ -13,7 +13,8 @@ and raises ``AssertionError`` where the contract fails:
   alarms exactly when its score is above it, :meth:`~.base.Detector.alarms`);
 - probes are named once and change nothing; a batch ``run`` equals stepping
   ``update`` (scores to rounding, so the same alarms); runs are deterministic, and
-  ``reset`` forgets the previous flight;
+  ``reset`` forgets the previous flight; a run continued from a snapshot (forked)
+  equals the run from t = 0;
 - it is causal: changing the data after time *t* changes no output before *t*.
 
 A plugin's own tests run them all with one decorator::
@@ -42,6 +43,7 @@ from alfa_bench.data.synthetic import write_corpus
 from .base import (
     Detector,
     NotFittedError,
+    forks,
     run_detector,
     training_segments,
 )
@@ -172,6 +174,35 @@ def check_batch_run_equals_streaming(detector: Detector) -> None:
         np.testing.assert_allclose(probes[name], ref_probes[name], rtol=1e-9, atol=1e-9)
 
 
+def check_forked_run_equals_run(detector: Detector) -> None:
+    """Continued from a :meth:`~.base.Detector.snapshot` (:func:`~.base.forks`), a
+    flight that shares a prefix with the one forked gives the run from t = 0: the
+    same alarms, and scores and probes to rounding. The flight here is the check
+    flight with its data after 0.6 of its length scrambled; it is forked at 0.3 and
+    0.6 of its length. A detector whose snapshot is None is run from t = 0 (its
+    forks are empty): skipped."""
+    d = _fitted(detector)
+    flight = _flight()
+    cut_s = 0.6 * flight.duration_s
+    at = forks(d, flight, [0.3 * flight.duration_s, cut_s], probes=True)
+    if not at:
+        _skip("its snapshot() is None: forked runs run from t = 0")
+    with tempfile.TemporaryDirectory() as tmp:
+        other = load_flight(_scrambled_after(flight, cut_s, Path(tmp)))
+    for fork in at.values():
+        assert fork.shared_by(sample(other, d.signals(), d.rate_hz), probes=True)
+        forked = run_detector(d, other, probes=True, fork=fork)
+        whole = run_detector(d, other, probes=True)
+        np.testing.assert_allclose(forked.score, whole.score, rtol=1e-9, atol=1e-9)
+        np.testing.assert_array_equal(forked.alarm, whole.alarm)
+        assert list(forked.probes) == list(whole.probes)
+        for name in whole.probes:
+            np.testing.assert_allclose(forked.probes[name], whole.probes[name],
+                                       rtol=1e-9, atol=1e-9)
+    # the scrambled data must reach the detector, or the fork could not differ
+    assert not np.array_equal(whole.score, run_detector(d, flight).score, equal_nan=True)
+
+
 def check_deterministic(detector: Detector) -> None:
     d, flight = _fitted(detector), _flight()
     _assert_same(run_detector(d, flight), run_detector(d, flight))
@@ -193,6 +224,23 @@ def _scrambled(cell: str) -> str:
         return cell
 
 
+def _scrambled_after(flight, cut_s: float, tmp: Path) -> Path:
+    """A copy of the check flight in ``tmp`` whose mavros rows after ``cut_s`` (flight
+    clock) have every field but time, seq and stamp scrambled."""
+    altered = shutil.copytree(_corpus() / _FLIGHT, tmp / _FLIGHT)
+    cut_ns = flight.t0_ns + int(cut_s * 1e9)
+    for f in altered.glob("*mavros*.csv"):
+        lines = f.read_text().splitlines()
+        out = [lines[0]]
+        for line in lines[1:]:
+            if int(line.split(",", 1)[0]) > cut_ns:
+                cells = line.split(",")
+                line = ",".join(cells[:3] + [_scrambled(c) for c in cells[3:]])
+            out.append(line)
+        f.write_text("\n".join(out) + "\n")
+    return altered
+
+
 def check_causal(detector: Detector) -> None:
     """Changing the data after time t changes no output before t (a detector that
     declares itself non-causal, a reference row, is skipped)."""
@@ -203,18 +251,7 @@ def check_causal(detector: Detector) -> None:
     base = run_detector(d, flight)
     cut_s = 0.7 * float(base.t[-1])
     with tempfile.TemporaryDirectory() as tmp:
-        altered = shutil.copytree(_corpus() / _FLIGHT, Path(tmp) / _FLIGHT)
-        for f in altered.glob("*mavros*.csv"):
-            lines = f.read_text().splitlines()
-            cut_ns = flight.t0_ns + int(cut_s * 1e9)
-            out = [lines[0]]
-            for line in lines[1:]:
-                if int(line.split(",", 1)[0]) > cut_ns:
-                    cells = line.split(",")   # every field after the cut, not time, seq, stamp
-                    line = ",".join(cells[:3] + [_scrambled(c) for c in cells[3:]])
-                out.append(line)
-            f.write_text("\n".join(out) + "\n")
-        changed = run_detector(d, load_flight(altered))
+        changed = run_detector(d, load_flight(_scrambled_after(flight, cut_s, Path(tmp))))
     before = int(np.searchsorted(base.t, cut_s, side="right"))
     assert before > 0
     _assert_same(base, changed, upto=before)
@@ -232,6 +269,7 @@ CHECKS = (
     check_each_channel_has_one_positive_threshold,
     check_probes_are_named_once_and_do_not_change_the_run,
     check_batch_run_equals_streaming,
+    check_forked_run_equals_run,
     check_deterministic,
     check_reset_forgets_the_previous_flight,
     check_causal,

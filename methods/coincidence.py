@@ -176,10 +176,21 @@ class Coincidence(Detector):
         self.last_ = {f: v[-1] for f, v in feats.items()}
         return self._scores({f: v[-1:] for f, v in feats.items()})[0]
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
-        """The batch form of :meth:`update` over ``s`` (equal to rounding)."""
+    def snapshot(self) -> dict:
+        """Nothing: every feature's windows fit in the last :data:`~.physics.HISTORY_S`,
+        which a continued :meth:`run` reads again from its segment."""
+        return {}
+
+    def run(self, s: Sampled, probes: bool = False, start: int = 0,
+            state: dict | None = None) -> tuple[np.ndarray, dict]:
+        """The batch form of :meth:`update` over ``s`` (equal to rounding); continued
+        from step ``start`` (any ``state``), it runs from :data:`~.physics.HISTORY_S`
+        before."""
         self.reset()
-        feats = features_of(s)
+        start = 0 if state is None else start
+        first = max(0, start - window_steps(HISTORY_S, RATE_HZ))
+        feats = {f: v[start - first:]
+                 for f, v in features_of(s.since(first), first_step=first).items()}
         kept = ({f"{c}/{f}": feats[f] / self.scale_[f]
                  for c, fs in zip(self.channels(), self._sets(), strict=True) for f in fs}
                 if probes else {})

@@ -183,6 +183,9 @@ class FfRlsMonitor(Detector):
     models_ : list
         Per-model state: ``rls`` (``theta_``, ``P_``, ``error_``, ``K_``),
         ``frozen``.
+    kernel_ : dict
+        Per model, the compiled kernel's counters and state after the last batch
+        :meth:`run` (what :meth:`snapshot` copies).
     """
 
     calibrated = True
@@ -259,15 +262,19 @@ class FfRlsMonitor(Detector):
                                  else (r["eps"][ok], r["dtheta"][ok]))
         return out
 
-    def _kernel_run(self, s: Sampled, spec: dict, from_prior: bool, freeze: bool) -> dict:
-        """One model over ``s`` through :func:`~.kernels.ffrls_advance`: from the fitted
-        prior (``from_prior``) or from theta = 0, P = p0 I; with or without freezing."""
+    def _kernel_run(self, s: Sampled, spec: dict, from_prior: bool, freeze: bool,
+                    start: int = 0, kernel: tuple | None = None) -> dict:
+        """One model over the steps ``start:`` of ``s`` through
+        :func:`~.kernels.ffrls_advance`: from the fitted prior (``from_prior``) or from
+        theta = 0, P = p0 I, or from ``kernel``, the (counts, state) it ended a run
+        with (``r["kernel"]``, copied); with or without freezing."""
         cols = {n: i for i, n in enumerate(s.names)}
-        u = normalise_inputs(s.x[:, [cols[c] for c in spec["inputs"]]], spec["inputs"])
-        y = np.ascontiguousarray(s.x[:, cols[spec["output"]]])
+        x = s.x[start:]
+        u = normalise_inputs(x[:, [cols[c] for c in spec["inputs"]]], spec["inputs"])
+        y = np.ascontiguousarray(x[:, cols[spec["output"]]])
         n_par = len(spec["inputs"]) + bool(spec["autoregressive"]) + 1
         name = spec["name"]
-        m, n = self._window(), s.t.size
+        m, n = self._window(), x.shape[0]
         config = np.zeros(len(FfrlsConfig))
         counts = np.zeros(len(FfrlsCount), dtype=np.int64)
         state = np.zeros(kernels.ffrls_state_size(n_par, m))
@@ -278,6 +285,8 @@ class FfRlsMonitor(Detector):
             max_trace = self.max_trace_ratio * float(np.trace(P))
         else:
             P[:], max_trace = np.eye(n_par) * self.p0, np.inf
+        if kernel is not None:
+            counts[:], state[:] = kernel
         fitted = hasattr(self, "gamma_r_")
         config[[FfrlsConfig.AR, FfrlsConfig.LAM, FfrlsConfig.MAX_TRACE, FfrlsConfig.FREEZE,
                 FfrlsConfig.M]] = spec["autoregressive"], self.forgetting, max_trace, freeze, m
@@ -292,6 +301,7 @@ class FfRlsMonitor(Detector):
                               out, r["dtheta"])
         r.update({row.name.lower(): out[row] for row in FfrlsOut})
         r["theta"], r["P"], r["y"] = theta.copy(), P.copy(), y
+        r["kernel"] = counts, state
         return r
 
     def fitted(self) -> dict:
@@ -360,12 +370,21 @@ class FfRlsMonitor(Detector):
             score[2 * j], score[2 * j + 1] = g, joint
         return score
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
-        """The compiled form of :meth:`update` over ``s`` (equal to rounding)."""
+    def snapshot(self) -> dict:
+        """Per model, the kernel's counters and state after the last :meth:`run`."""
+        return {n: (c.copy(), st.copy()) for n, (c, st) in self.kernel_.items()}
+
+    def run(self, s: Sampled, probes: bool = False, start: int = 0,
+            state: dict | None = None) -> tuple[np.ndarray, dict]:
+        """The compiled form of :meth:`update` over ``s`` (equal to rounding); continued
+        from a :meth:`snapshot` at step ``start``, over the steps from there."""
         self.reset()
-        score, kept = [], {}
+        start = 0 if state is None else start
+        score, kept, self.kernel_ = [], {}, {}
         for spec in self.models:
-            r = self._kernel_run(s, spec, from_prior=True, freeze=True)
+            r = self._kernel_run(s, spec, from_prior=True, freeze=True, start=start,
+                                 kernel=None if state is None else state[spec["name"]])
+            self.kernel_[spec["name"]] = r["kernel"]
             score += [r["g"], r["joint"]]
             if probes:
                 kept[f"{spec['name']}/prediction"] = r["y"] - r["eps"]

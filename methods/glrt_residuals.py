@@ -143,17 +143,26 @@ class GlrtResiduals(PairDetector):
             out["arx_theta"] = [t.tolist() for t in self.theta_]
         return out
 
-    def _residual_run(self, s: Sampled) -> np.ndarray:
-        """Residuals over a segment, NaN where not armed: what :meth:`update` sees."""
+    def _residual_run(self, s: Sampled, start: int = 0, rls: dict | None = None
+                      ) -> np.ndarray:
+        """Residuals over the steps ``start:`` of a segment, NaN where not armed: what
+        :meth:`update` sees. The RLS residuals continue from the recursion's
+        :meth:`~.rls_arx_zscore.RlsArxZscore.snapshot` ``rls`` (from the start if None);
+        the fixed ARX ones read the regressors' history again from ``s``."""
         if self.residuals == "arx":
-            r = np.full((s.t.size, len(self.pairs)), np.nan)
-            start = max(self.na, self._nb() - 1)
+            armed = max(self.na, self._nb() - 1)
+            first = max(0, start - armed)
+            seg = s.since(first)
+            r = np.full((seg.t.size, len(self.pairs)), np.nan)
             for j, (iu, iy) in enumerate(self._cols()):
-                phi, y = arx_regressors(s.x[:, iu], s.x[:, iy], self.na, self._nb())
-                r[start:, j] = y - phi @ self.theta_[j]        # r = y - phi' theta
-            return r
-        self._reset_residuals()
-        return self.rls_arx_.advance(s.x, s.fresh)["judged"]
+                phi, y = arx_regressors(seg.x[:, iu], seg.x[:, iy], self.na, self._nb())
+                r[armed:, j] = y - phi @ self.theta_[j]        # r = y - phi' theta
+            return r[start - first:]
+        if rls is None:
+            self._reset_residuals()
+        else:
+            self.rls_arx_.restore(rls)
+        return self.rls_arx_.advance(s.x[start:], s.fresh[start:])["judged"]
 
     # -- streaming ---------------------------------------------------------------------
 
@@ -167,16 +176,27 @@ class GlrtResiduals(PairDetector):
     def update(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:
         return self._glrt_step(self._residual_step(x, fresh))
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
+    def snapshot(self) -> dict:
+        """The GLRT windows, and the RLS recursion's state where residuals are ``rls``."""
+        return {"glrt": (self.glrt_buf_.copy(), self.glrt_count_.copy()),
+                "rls": self.rls_arx_.snapshot() if self.residuals == "rls" else None}
+
+    def run(self, s: Sampled, probes: bool = False, start: int = 0,
+            state: dict | None = None) -> tuple[np.ndarray, dict]:
         """The batch form: residuals of the whole segment at once, then the GLRT kernel;
-        equal to streaming to rounding."""
+        equal to streaming to rounding. Continued from a :meth:`snapshot` at step
+        ``start``, it runs over the steps from there."""
         self.reset()
-        r = self._residual_run(s)
+        if state is None:
+            start = 0
+        else:
+            self.glrt_buf_[:], self.glrt_count_[:] = state["glrt"]
+        r = self._residual_run(s, start, None if state is None else state["rls"])
         g = np.column_stack([self._glrt_run(j, r[:, j]) for j in range(len(self.pairs))])
         kept = {}
         if probes:
             for j, (p, (_, iy)) in enumerate(zip(self.pairs, self.cols_, strict=True)):
-                kept[f"{p['name']}/prediction"] = s.x[:, iy] - r[:, j]
+                kept[f"{p['name']}/prediction"] = s.x[start:, iy] - r[:, j]
                 kept[f"{p['name']}/residual"] = r[:, j]
         return g, kept
 

@@ -72,6 +72,9 @@ class KalmanOkid(Detector):
         Per output.
     filters_ : list of :class:`~filterpy.kalman.KalmanFilter`
         Per output; ``y`` holds the last innovation, ``K`` the gain.
+    x_ : list of ndarray
+        Per output, the state estimate :math:`\\hat x` after the last batch :meth:`run`
+        (what :meth:`snapshot` copies).
     output_, innovation_ : ndarray
         The last output and innovation per output (NaN while not armed).
     """
@@ -125,7 +128,7 @@ class KalmanOkid(Detector):
             if not np.allclose(m.A @ np.linalg.solve(m.A, m.L), m.L):
                 raise ValueError(f"OKID model of {out!r} has a singular A: no filter gain")
         self.models_ = models
-        runs = [self._innovations(s) for s in segments]
+        runs = [self._innovations(s, self._start_states()) for s in segments]
         e = np.vstack(runs)
         self.innovation_mean_ = np.nanmean(e, axis=0)
         self.innovation_var_ = np.nanvar(e, axis=0)
@@ -144,15 +147,19 @@ class KalmanOkid(Detector):
                       "threshold": float(self.threshold_[i])}
                 for i, (out, m) in enumerate(zip(self.outputs, self.models_, strict=True))}
 
-    def _innovations(self, s: Sampled) -> np.ndarray:
-        """Innovations over a segment from the filters' start: the compiled form of the
-        stepwise filterpy filters, equal to rounding."""
-        u, y = self._split(s)
-        e = np.empty((s.t.size, len(self.outputs)))
+    def _start_states(self) -> list[np.ndarray]:
+        return [np.zeros(m.A.shape[0]) for m in self.models_]   # x(0) = 0, as the filters'
+
+    def _innovations(self, s: Sampled, x: list[np.ndarray], start: int = 0) -> np.ndarray:
+        """Innovations over the steps ``start:`` of a segment, from the filters' state
+        estimates ``x`` (updated in place): the compiled form of the stepwise filterpy
+        filters, equal to rounding."""
+        u, y = self._split(s.since(start))
+        e = np.empty((s.t.size - start, len(self.outputs)))
         for i, m in enumerate(self.models_):
             kernels.kalman_innovations(m.A, m.B, m.C, m.D, np.linalg.solve(m.A, m.L), u,
-                                       np.ascontiguousarray(y[:, i]), self._lags(),
-                                       np.zeros(m.A.shape[0]), e[:, i])
+                                       np.ascontiguousarray(y[:, i]),
+                                       max(0, self._lags() - start), x[i], e[:, i])
         return e
 
     @staticmethod
@@ -196,14 +203,24 @@ class KalmanOkid(Detector):
         e = self._innovation_step(x)
         return (e - self.innovation_mean_) ** 2 / self.innovation_var_  # nu = (e - mu)^2 / s
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
-        """The batch form, through :func:`~.kernels.kalman_innovations`."""
+    def snapshot(self) -> list[np.ndarray]:
+        """The filters' state estimates after the last :meth:`run`."""
+        return [x.copy() for x in self.x_]
+
+    def run(self, s: Sampled, probes: bool = False, start: int = 0,
+            state: list[np.ndarray] | None = None) -> tuple[np.ndarray, dict]:
+        """The batch form, through :func:`~.kernels.kalman_innovations`; continued from
+        the state estimates of a :meth:`snapshot` at step ``start``."""
         self.reset()
-        e = self._innovations(s)
+        if state is None:
+            start, self.x_ = 0, self._start_states()
+        else:
+            self.x_ = [x.copy() for x in state]
+        e = self._innovations(s, self.x_, start)
         nis = (e - self.innovation_mean_) ** 2 / self.innovation_var_  # nu = (e - mu)^2 / s
         kept = {}
         if probes:
-            _, y = self._split(s)
+            _, y = self._split(s.since(start))
             for i, name in enumerate(self.outputs):
                 kept[f"{name}/prediction"] = y[:, i] - e[:, i]
                 kept[f"{name}/innovation"] = e[:, i]

@@ -173,10 +173,19 @@ class LearnedFusion(Detector):
         return {f"{m['name']}/step": (float(steps[c]) if steps is not None else math.nan)
                 for c, m in enumerate(self.models)}
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
-        """The batch form of :meth:`update` over ``s`` (equal to rounding)."""
+    def snapshot(self) -> dict:
+        """Nothing: the bank's steps depend on its last
+        :meth:`~.residual_bank.ResidualBank.memory_steps` steps only."""
+        return {}
+
+    def run(self, s: Sampled, probes: bool = False, start: int = 0,
+            state: dict | None = None) -> tuple[np.ndarray, dict]:
+        """The batch form of :meth:`update` over ``s`` (equal to rounding); continued
+        from step ``start`` as the bank's run is."""
         self.reset()
-        d = self.bank_.steps(self.bank_.residuals(s)[1])
+        start = 0 if state is None else start
+        first = max(0, start - self.bank_.memory_steps())
+        d = self.bank_.steps(self.bank_.residuals(s.since(first))[1])[start - first:]
         score = self._anomaly(d)[:, None]
         kept = ({f"{m['name']}/step": d[:, c] for c, m in enumerate(self.models)}
                 if probes else {})

@@ -231,6 +231,13 @@ class NestedSelection(Detector):
     def update(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:
         return self.base_.update(x, fresh)
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
+    def snapshot(self) -> object | None:
         self._check_fitted("base_")
-        return self.base_.run(s, probes)
+        return self.base_.snapshot()
+
+    def run(self, s: Sampled, probes: bool = False, start: int = 0,
+            state: object | None = None) -> tuple[np.ndarray, dict]:
+        self._check_fitted("base_")
+        if state is None:
+            return self.base_.run(s, probes)
+        return self.base_.run(s, probes, start=start, state=state)

@@ -375,11 +375,26 @@ class ResidualBank(Detector):
         return {f"{m['name']}/{key}": (float(last[key][c]) if last else math.nan)
                 for c, m in enumerate(self.models) for key in ("prediction", "residual", "step")}
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
-        """The batch form of :meth:`update` over ``s`` (equal to rounding)."""
+    def memory_steps(self) -> int:
+        """The steps before a step that its score depends on: the longest lag of (1)
+        and both windows of (2)."""
+        return max(self._lags()) + sum(self._windows())
+
+    def snapshot(self) -> dict:
+        """Nothing: a score depends on the last :meth:`memory_steps` steps only, which
+        a continued :meth:`run` reads again from its segment."""
+        return {}
+
+    def run(self, s: Sampled, probes: bool = False, start: int = 0,
+            state: dict | None = None) -> tuple[np.ndarray, dict]:
+        """The batch form of :meth:`update` over ``s`` (equal to rounding); continued
+        from step ``start`` (any ``state``), it runs from :meth:`memory_steps` before."""
         self.reset()
-        pred, res = self.residuals(s)
-        d = self.steps(res)
+        start = 0 if state is None else start
+        first = max(0, start - self.memory_steps())
+        pred, res = self.residuals(s.since(first))
+        d = self.steps(res)[start - first:]
+        pred, res = pred[start - first:], res[start - first:]
         score = self.scores(d)
         kept = {}
         if probes:

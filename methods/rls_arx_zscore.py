@@ -203,8 +203,28 @@ class RlsArxZscore(PairDetector):
     def update(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:
         return self.advance(x[None, :], fresh[None, :])["z"][0]
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
-        out = self.reset().advance(s.x, s.fresh)
+    def snapshot(self) -> dict:
+        """Each pair's counters and state array, and the last step's outputs."""
+        return {"pairs": [(p.counts.copy(), p.state.copy()) for p in self.pairs_],
+                "last": {k: v.copy() for k, v in self.last_.items()}}
+
+    def restore(self, state: dict) -> RlsArxZscore:
+        """Reset, then take the pairs' state from a :meth:`snapshot` (copied, so that
+        the snapshot serves again); the views of each state array stay its views."""
+        self.reset()
+        for p, (counts, arrays) in zip(self.pairs_, state["pairs"], strict=True):
+            p.counts[:], p.state[:] = counts, arrays
+        self.last_ = {k: v.copy() for k, v in state["last"].items()}
+        return self
+
+    def run(self, s: Sampled, probes: bool = False, start: int = 0,
+            state: dict | None = None) -> tuple[np.ndarray, dict]:
+        if state is None:
+            self.reset()
+            start = 0
+        else:
+            self.restore(state)
+        out = self.advance(s.x[start:], s.fresh[start:])
         kept = ({name: out[kind][:, j] for name, (kind, j) in _probe_index(self.pairs).items()}
                 if probes else {})
         return out["z"], kept
