@@ -48,10 +48,15 @@ from .provenance import provenance, read_table, run_provenance, stamp
 from .scoring import flight_outcome
 from .traces import write_trace
 
-__all__ = ["calibration_failure", "detect_all", "detection_record", "iter_records",
-           "read_failures", "read_records", "write_detections", "write_record"]
+__all__ = ["RUN_RECORD", "calibration_failure", "detect_all", "detection_record",
+           "iter_records", "read_failures", "read_records", "read_run_record", "record_paths",
+           "write_detections", "write_record"]
 
 log = logging.getLogger(__name__)
+
+#: in an injected-detections folder, what its records share: each fold's calibration
+#: and the run's provenance, written once instead of in each of thousands of records
+RUN_RECORD = "run.json"
 
 
 def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest: pd.DataFrame,
@@ -285,12 +290,42 @@ def read_records(folders) -> list[dict]:
     return list(iter_records(folders))
 
 
+def record_paths(folder) -> list[Path]:
+    """The record files of a detections folder, by name (not its :data:`RUN_RECORD`)."""
+    return [p for p in sorted(Path(folder).glob("*.json")) if p.name != RUN_RECORD]
+
+
 def iter_records(folders) -> Iterator[dict]:
     """The records of :func:`read_records`, one at a time, so that memory does not
-    grow with the injected grid (145,000 records at 16 times ALFA's flights)."""
+    grow with the injected grid (145,000 records at 16 times ALFA's flights). An
+    injected record's ``calibration`` names its fold only, and its ``provenance``
+    the flight's checksum: the rest is its folder's :data:`RUN_RECORD`
+    (:func:`read_run_record`)."""
     for d in folders:
-        for p in sorted(Path(d).glob("*.json")):
+        for p in record_paths(d):
             yield json.loads(p.read_text())
+
+
+def read_run_record(folder) -> dict:
+    """The :data:`RUN_RECORD` of an injected-detections folder: ``provenance`` (the
+    run's, with each fold's calibration checksums) and ``folds`` (each fold's
+    calibration block, as a real flight's record holds it)."""
+    return json.loads((Path(folder) / RUN_RECORD).read_text())
+
+
+def _referencing(record: dict, run: dict) -> dict:
+    """``record`` with its calibration and provenance moved into ``run`` (the folder's
+    :data:`RUN_RECORD`, filled here), keeping the fold's name and the flight's
+    checksum."""
+    cal, prov = record["calibration"], record["provenance"]
+    if cal is not None:
+        run["folds"][cal["fold"]] = cal
+        run["calibration_sha256"][cal["fold"]] = prov["inputs"]["calibration_sha256"]
+    if "provenance" not in run:
+        run["provenance"] = {k: v for k, v in prov.items() if k != "inputs"}
+    return {**record, "calibration": None if cal is None else {"fold": cal["fold"]},
+            "provenance": {"flight_sha256": prov["inputs"]["flight_sha256"],
+                           "run": RUN_RECORD}}
 
 
 def read_failures(folders) -> list[pd.DataFrame]:
@@ -311,6 +346,8 @@ def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
     manifest (in ``flights``) are scored in the same pass, each by the fit of its
     source's fold (one fit per fold for both), and their records and failures are
     written to the folder, without traces: a record holds all that is read of them.
+    Their calibration blocks and provenance, the same for every flight of a fold,
+    are written once, to the folder's :data:`RUN_RECORD`, which the records name.
     """
     extra, folder = injected if injected is not None else (manifest.iloc[:0], None)
     for path in (out, traces, folder):
@@ -319,11 +356,14 @@ def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
     failures = None if strict else []
     scored = pd.concat([manifest, extra], ignore_index=True) if len(extra) else manifest
     grid = set(extra["flight"])
+    run = {"folds": {}, "calibration_sha256": {}}
     for record, trace in detect_all(method, spec, flights, scored, calibration, failures,
                                     calibrate_on=manifest):
         name = record["flight"]
-        write_record(record, (folder if name in grid else out) / f"{name}.json")
-        if name not in grid:
+        if name in grid:
+            write_record(_referencing(record, run), folder / f"{name}.json")
+        else:
+            write_record(record, out / f"{name}.json")
             write_trace(trace, traces / f"{name}.npz", record["provenance"])
         log.info("%s %s: %s, first alarm %s", method, name, record["outcome"],
                  record["first_alarm_s"])
@@ -336,3 +376,6 @@ def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
             pd.DataFrame(rows, columns=FAILURE_COLUMNS).to_csv(where / "failures.csv",
                                                                index=False)
             stamp(where / "failures.csv", prov)
+    if folder is not None:
+        run.setdefault("provenance", provenance(spec, {}))   # no injected flight scored
+        write_record(run, folder / RUN_RECORD)

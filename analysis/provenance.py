@@ -181,7 +181,8 @@ def _run_file_of(path: Path) -> tuple[dict, str]:
 def read_provenance(path: str | Path) -> dict:
     """The provenance of a result file: its own (see :func:`stamp`), or for a CSV,
     Markdown, HTML or LaTeX table that of the run file listing it, whose checksum it must
-    still match where one is recorded."""
+    still match where one is recorded. An injected flight's record names the run record
+    of its folder, which holds the rest (``analysis.detections.RUN_RECORD``)."""
     path = Path(path)
     match path.suffix:
         case ".csv" | ".tex" | ".md" | ".html":
@@ -202,7 +203,16 @@ def read_provenance(path: str | Path) -> dict:
             with np.load(path) as z:
                 return json.loads(str(z["provenance"][0]))
         case ".json":
-            return json.loads(path.read_text())["provenance"]
+            record = json.loads(path.read_text())
+            prov = record["provenance"]
+            if "run" not in prov:
+                return prov
+            # an injected flight's record: the run's provenance is its folder's run record
+            run = json.loads((path.parent / prov["run"]).read_text())
+            fold = (record.get("calibration") or {}).get("fold")
+            return {**run["provenance"], "inputs": {
+                "flight_sha256": prov["flight_sha256"],
+                "calibration_sha256": run["calibration_sha256"].get(fold, {})}}
         case ".rrd":       # the recording's property (rerun_log.write_rerun_log)
             import rerun.chunk as rc
             for chunk in rc.RrdReader(path).store().stream().to_chunks():

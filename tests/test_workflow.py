@@ -16,6 +16,7 @@ from broken import GT, IMU, ROLL, _gap, _late_start, edit, set_cell, shift_time
 from loopback import make_archive, serve_archive
 from recordings import content
 
+from alfa_bench.analysis.detections import RUN_RECORD, iter_records, read_run_record
 from alfa_bench.analysis.provenance import RUN_FILE, read_provenance, read_table
 from alfa_bench.analysis.traces import read_trace
 from alfa_bench.data.synthetic import write_flight
@@ -171,6 +172,19 @@ def test_the_injected_grid_is_scored_and_isolated(runs, corpus):
     sensors_iso = read_table(out / "tables/isolation_sensors.csv")
     assert len(sensors_iso) == len(injected) * len(detectors)
     assert read_table(out / "injected/skipped.csv").empty   # every sensor is live here
+    # an injected record names its fold and its flight's checksum; the folder's run
+    # record holds, once, the fold's calibration as the source's own record has it
+    folder = out / "injected/detections/glrt_arx"
+    run = read_run_record(folder)
+    records = list(iter_records([folder]))
+    assert len(records) == len(injected)
+    sha = dict(zip(injected["flight"], injected["sha256"], strict=True))
+    real = {r["flight"]: r for r in iter_records([out / "detections/glrt_arx"])}
+    source = dict(zip(injected["flight"], injected["fault_source"], strict=True))
+    for r in records:
+        assert r["provenance"] == {"flight_sha256": sha[r["flight"]], "run": RUN_RECORD}
+        assert run["folds"][r["calibration"]["fold"]] == real[source[r["flight"]]]["calibration"]
+    assert set(run["provenance"]) == {"code", "packages", "config", "calibration"}
     actuators = read_table(out / "tables/isolation_actuators.csv")
     assert set(actuators["true"]) == {"engine", "rudder", "aileron"}
     assert "true \\ isolated" in (out / "tables/isolation_actuators.md").read_text()
@@ -243,7 +257,8 @@ def test_every_result_file_records_its_provenance(runs, corpus):
     files = [p for p in (work / "results").rglob("*") if p.is_file()
              and not p.name.startswith(".snakemake")     # Snakemake's directory markers
              and not {"logs", "benchmarks", "cache"} & set(p.relative_to(work).parts)
-             and p not in (work / "results/injected/flights.csv", work / RUN_FILE)]
+             and p not in (work / "results/injected/flights.csv", work / RUN_FILE)
+             and p.name != RUN_RECORD]     # what the injected records share: read through them
     files += [work / "paper/build/paper.md", work / "paper/build/results.tex"]
     assert {p.suffix for p in files} == {".csv", ".md", ".tex", ".json", ".npz", ".png", ".rrd",
                                          ".parquet", ".html"}
