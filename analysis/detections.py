@@ -336,11 +336,12 @@ def read_failures(folders) -> list[pd.DataFrame]:
 
 def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
                      manifest: pd.DataFrame, calibration: dict, *, strict: bool, config: dict,
-                     out: Path, traces: Path,
+                     out: Path, traces: Path, recordings: Path | None = None,
                      injected: tuple[pd.DataFrame, Path] | None = None) -> None:
     """Run :func:`detect_all` and write ``out/<flight>.json``, ``traces/<flight>.npz``
     and ``out/failures.csv`` (the flights excluded, empty when ``strict``, which
-    raises instead), each with its provenance.
+    raises instead), each with its provenance; with ``recordings``, also the method's
+    part of each flight's rerun recording there (:func:`~.rerun_log.write_rerun_part`).
 
     With ``injected`` (its manifest, and a folder), the injected flights of that
     manifest (in ``flights``) are scored in the same pass, each by the fit of its
@@ -350,7 +351,9 @@ def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
     are written once, to the folder's :data:`RUN_RECORD`, which the records name.
     """
     extra, folder = injected if injected is not None else (manifest.iloc[:0], None)
-    for path in (out, traces, folder):
+    if recordings is not None:
+        from .rerun_log import write_rerun_part  # rerun: only where parts are written
+    for path in (out, traces, recordings, folder):
         if path is not None:
             path.mkdir(parents=True, exist_ok=True)
     failures = None if strict else []
@@ -365,6 +368,8 @@ def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
         else:
             write_record(record, out / f"{name}.json")
             write_trace(trace, traces / f"{name}.npz", record["provenance"])
+            if recordings is not None:
+                write_rerun_part(name, method, trace, recordings / f"{name}.rrd")
         log.info("%s %s: %s, first alarm %s", method, name, record["outcome"],
                  record["first_alarm_s"])
     for where, rows, prov in [

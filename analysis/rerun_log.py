@@ -40,7 +40,8 @@ from alfa_bench.methods import Trace
 from .provenance import code_version
 from .sweep import ratio
 
-__all__ = ["TIMELINE", "blueprint", "signal_group", "write_rerun_log"]
+__all__ = ["TIMELINE", "blueprint", "merge_rerun_log", "signal_group", "write_rerun_log",
+           "write_rerun_part"]
 
 log = logging.getLogger(__name__)
 
@@ -112,28 +113,43 @@ def _series(rec: rr.RecordingStream, path: str, t: np.ndarray, v: np.ndarray, na
                      columns=rr.Scalars.columns(scalars=v[keep]))
 
 
-def _events(flight: Flight, traces: dict[str, Trace]) -> list[tuple[float, str, str]]:
+def _alarm_events(method: str, tr: Trace) -> list[tuple[float, str, str]]:
     events = []
-    if flight.fault.onset_s is not None:
-        events.append((flight.fault.onset_s, f"fault onset: {flight.fault.fault_class}",
-                       "WARN"))
-        events.append((flight.fault.end_s, "fault end", "INFO"))
-    for method, tr in traces.items():
-        for i, (start, stop) in enumerate(tr.alarm_intervals()):
-            k = int(np.searchsorted(tr.t, start))
-            channels = [c for c, a in zip(tr.channels, tr.alarm[k], strict=True) if a]
-            first = "first alarm" if i == 0 else "alarm"
-            events.append((start, f"{first} {method} ({', '.join(channels)}) until "
-                           f"{stop:.2f} s", "ERROR"))
-    return sorted(events, key=lambda e: (e[0], e[1]))
+    for i, (start, stop) in enumerate(tr.alarm_intervals()):
+        k = int(np.searchsorted(tr.t, start))
+        channels = [c for c, a in zip(tr.channels, tr.alarm[k], strict=True) if a]
+        first = "first alarm" if i == 0 else "alarm"
+        events.append((start, f"{first} {method} ({', '.join(channels)}) until "
+                       f"{stop:.2f} s", "ERROR"))
+    return events
 
 
-def write_rerun_log(flight: Flight, traces: dict[str, Trace], signals: list[str],
-                    path: str | Path, provenance: dict) -> None:
-    """Write the recording of ``flight`` with the ``traces`` of each method (with
-    probes), the raw ``signals`` and the run's ``provenance`` to ``path``. A signal the
-    flight cannot give (a column a method excluded it for) is left out, and logged."""
-    path = Path(path)
+def _fault_events(flight: Flight) -> list[tuple[float, str, str]]:
+    if flight.fault.onset_s is None:
+        return []
+    return [(flight.fault.onset_s, f"fault onset: {flight.fault.fault_class}", "WARN"),
+            (flight.fault.end_s, "fault end", "INFO")]
+
+
+def _method_entities(rec: rr.RecordingStream, method: str, tr: Trace) -> None:
+    """A method's entities: its scores, thresholds, probes and overview line."""
+    base = f"methods/{method}"
+    for c, channel in enumerate(tr.channels):
+        _series(rec, f"{base}/scores/{channel}/score", tr.t, tr.score[:, c], channel)
+        _series(rec, f"{base}/scores/{channel}/threshold", tr.t[[0, -1]],
+                np.full(2, tr.threshold[c]), f"{channel} threshold", _RED)
+    for probe, values in tr.probes.items():
+        _series(rec, f"{base}/probes/{probe}", tr.t, values, probe)
+    r = ratio(tr)
+    _series(rec, f"overview/{method}", tr.t, np.where(np.isinf(r), np.nan, r), method)
+
+
+def _recording(flight: Flight, methods: list[str], signals: list[str], path: Path,
+               provenance: dict, fill) -> None:
+    """The recording of ``flight`` at ``path``: its properties, blueprint (a tab per
+    method of ``methods``), raw ``signals`` and overview bars, then what ``fill(rec)``
+    logs of the methods, then the event log of ``fill``'s alarm events with the
+    fault's."""
     path.parent.mkdir(parents=True, exist_ok=True)
     raw = {}
     for s in signals:
@@ -147,7 +163,7 @@ def write_rerun_log(flight: Flight, traces: dict[str, Trace], signals: list[str]
     span = (None if fault is None or fault.onset_s is None
             else (fault.onset_s, fault.end_s))
     title = f"{fault.fault_class if fault else 'unlabelled'}: {flight.id}"
-    rec.save(path, default_blueprint=blueprint(list(traces), groups, title, span))
+    rec.save(path, default_blueprint=blueprint(methods, groups, title, span))
     rec.send_recording_name(flight.id)
     rec.send_property("flight", rr.AnyValues(
         flight=flight.id, date=flight.date, label=flight.label,
@@ -160,26 +176,63 @@ def write_rerun_log(flight: Flight, traces: dict[str, Trace], signals: list[str]
 
     for s, (t, v) in raw.items():
         _series(rec, f"signals/{signal_group(s)}/{s}", t, v, s, step=True)
-    for method, tr in traces.items():
-        base = f"methods/{method}"
-        for c, channel in enumerate(tr.channels):
-            _series(rec, f"{base}/scores/{channel}/score", tr.t, tr.score[:, c], channel)
-            _series(rec, f"{base}/scores/{channel}/threshold", tr.t[[0, -1]],
-                    np.full(2, tr.threshold[c]), f"{channel} threshold", _RED)
-        for probe, values in tr.probes.items():
-            _series(rec, f"{base}/probes/{probe}", tr.t, values, probe)
-        r = ratio(tr)
-        _series(rec, f"overview/{method}", tr.t, np.where(np.isinf(r), np.nan, r), method)
+    alarms = fill(rec)
     if span is not None:
         # a bar along the top of the overview from onset to the fault's end
         _series(rec, "overview/fault", np.array(span), np.full(2, 2.9), "fault", _RED)
     _series(rec, "overview/threshold", np.array([0.0, flight.duration_s]), np.ones(2),
             "alarm level", _RED)
 
-    events = _events(flight, traces) if fault else []
+    events = sorted(_fault_events(flight) + alarms, key=lambda e: (e[0], e[1])) if fault else []
     if events:
         times, texts, levels = zip(*events, strict=True)
         rec.send_columns("events", indexes=[rr.TimeColumn(TIMELINE, duration=list(times))],
                          columns=rr.TextLog.columns(text=list(texts), level=list(levels)))
     rec.flush()
     rec.disconnect()
+
+
+def write_rerun_log(flight: Flight, traces: dict[str, Trace], signals: list[str],
+                    path: str | Path, provenance: dict) -> None:
+    """Write the recording of ``flight`` with the ``traces`` of each method (with
+    probes), the raw ``signals`` and the run's ``provenance`` to ``path``. A signal the
+    flight cannot give (a column a method excluded it for) is left out, and logged."""
+    def fill(rec):
+        for method, tr in traces.items():
+            _method_entities(rec, method, tr)
+        return [e for method, tr in traces.items() for e in _alarm_events(method, tr)]
+
+    _recording(flight, list(traces), signals, Path(path), provenance, fill)
+
+
+def write_rerun_part(flight_id: str, method: str, trace: Trace, path: str | Path) -> None:
+    """One method's part of the recording of flight ``flight_id``: its entities in
+    ``path`` (a recording of the flight's id, without properties or blueprint) and its
+    alarm events beside it, in ``path`` with suffix ``.events.json``. The detect job
+    of the method writes it; :func:`merge_rerun_log` puts the parts together."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    rec = rr.RecordingStream(_APPLICATION, recording_id=flight_id, send_properties=False)
+    rec.save(path)
+    _method_entities(rec, method, trace)
+    rec.flush()
+    rec.disconnect()
+    path.with_suffix(".events.json").write_text(json.dumps(_alarm_events(method, trace)))
+
+
+def merge_rerun_log(flight: Flight, parts: dict[str, Path], signals: list[str],
+                    path: str | Path, provenance: dict) -> None:
+    """The recording :func:`write_rerun_log` writes, from each method's part
+    (:func:`write_rerun_part`, by method) instead of its trace: the parts' chunks are
+    passed on as they are, without drawing them again."""
+    import rerun.chunk as rc
+
+    def fill(rec):
+        alarms = []
+        for part in parts.values():
+            rec.send_chunks(rc.RrdReader(part).store().stream())
+            alarms += [tuple(e) for e in json.loads(
+                Path(part).with_suffix(".events.json").read_text())]
+        return alarms
+
+    _recording(flight, list(parts), signals, Path(path), provenance, fill)

@@ -309,18 +309,21 @@ class Fork:
     score : ndarray, shape (k, c)
     probes : dict of str to ndarray, shape (k,)
         Empty unless the run kept them.
+    kept_probes : bool
+        Whether the run kept the probes.
     """
 
     sampled: Sampled
     state: object
     score: np.ndarray
     probes: dict
+    kept_probes: bool
 
     def shared_by(self, s: Sampled, probes: bool) -> bool:
         """Whether ``s`` begins with exactly these steps (times, values, freshness), and
         the fork kept the probes a run asks for."""
         k = self.sampled.t.size
-        return (s.t.size >= k and (bool(self.probes) or not probes)
+        return (s.t.size >= k and (self.kept_probes or not probes)
                 and np.array_equal(s.t[:k], self.sampled.t)
                 and np.array_equal(s.x[:k], self.sampled.x, equal_nan=True)
                 and np.array_equal(s.fresh[:k], self.sampled.fresh))
@@ -343,7 +346,7 @@ def forks(detector: Detector, flight: Flight, times_s, probes: bool = False
         state = detector.snapshot()
         if state is None:
             return {}
-        out[t_s] = Fork(head, state, score, kept)
+        out[t_s] = Fork(head, state, score, kept, probes)
     return out
 
 

@@ -11,6 +11,8 @@ rule detect_reference:
     output:
         detections=directory("results/detections/{method}"),
         traces=directory("results/traces/{method}"),
+        # the method's part of each flight's recording, which rerun_logs merges
+        recordings=directory("results/rerun_parts/{method}"),
     params:
         # canonical JSON, so that only a changed value (not a reordered key) re-runs it
         spec=lambda w: json.dumps(config["methods"][w.method], sort_keys=True),
@@ -37,6 +39,7 @@ use rule detect_reference as detect with:
     output:
         detections=directory("results/detections/{method}"),
         traces=directory("results/traces/{method}"),
+        recordings=directory("results/rerun_parts/{method}"),
         injected=directory("results/injected/detections/{method}"),
     params:
         spec=lambda w: json.dumps(config["methods"][w.method], sort_keys=True),

@@ -4,7 +4,8 @@ rule rerun_logs:
     input:
         manifest="results/flights.csv",
         cache="results/cache",
-        traces=expand("results/traces/{method}", method=METHODS),
+        # each method's part of every recording, written by its detect job
+        parts=expand("results/rerun_parts/{method}", method=METHODS),
     output:
         directory("results/rerun"),
     params:
