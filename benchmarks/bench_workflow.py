@@ -1,7 +1,7 @@
 """Wall time of ``snakemake all --cores 2`` from a clean ``results/``, and how it grows.
 
     ALFA_DIR=/path/to/alfa .venv/bin/python benchmarks/bench_workflow.py \
-        [--flights 1 2 4] [--settings 1 4 16]
+        [--flights 1 2 4] [--settings 1 4 16] [--changed] [--extra 7] [--root DIR]
 
 - ``--flights``: the flights of ``$ALFA_DIR/processed`` replicated k times (copies are
   symlinks under new names on the same dates, so the leave-one-day-out folds stay
@@ -11,14 +11,25 @@
 - ``--changed``: the run over the flights once, then ``glrt_arx_chi2``'s false-alarm
   probability halved and ``snakemake all`` again: the re-run's wall time and the jobs it
   ran, per rule.
+- ``--extra N``: every corpus also holds N more copies (every sixth flight, recorded
+  three hours later on its date): ``--extra 7`` makes the 40 local flights a corpus of
+  ALFA's 47.
+- ``--root DIR``: run the workflow (Snakefile, config) of another checkout, with the
+  Python of its ``.venv``: the same cases, timed on older code in the same session.
+- ``--methods-of DIR``, ``--targets RULE ...``: keep only the method runs of another
+  checkout's config, and run these rules instead of ``all``, so that two commits with
+  different runs and products can be timed on the same work.
 
-Each case runs in a fresh temporary working directory; prints a Markdown table.
+Each case runs in a fresh temporary working directory; prints a Markdown table of wall
+times, then the wall time and peak resident memory of each job of each run from empty
+that keeps a Snakemake benchmark file.
 """
 
 from __future__ import annotations
 
 import argparse
 import copy
+import csv
 import os
 import re
 import subprocess
@@ -30,33 +41,39 @@ from pathlib import Path
 
 import yaml
 
-ROOT = Path(__file__).resolve().parent.parent
 _FINISHED = re.compile(r"^Finished jobid: \d+ \(Rule: (\w+)\)$", re.M)
 _TIME = re.compile(r"^(carbonZ_\d{4}-\d{2}-\d{2}-)(\d{2})(-\d{2}-\d{2}.*)$")
 
 
-def replicate(processed: Path, dest: Path, copies: int) -> int:
+def _link(flight: Path, dest: Path, shift_h: int) -> None:
+    m = _TIME.match(flight.name)
+    name = f"{m[1]}{int(m[2]) + shift_h:02d}{m[3]}"
+    folder = dest / name
+    folder.mkdir(parents=True)       # a clash with another flight's name is an error
+    for f in flight.iterdir():
+        (folder / f.name.replace(flight.name, name, 1)).symlink_to(f.resolve())
+
+
+def replicate(processed: Path, dest: Path, copies: int, extra: int = 0) -> int:
     """Symlink every flight of ``processed`` ``copies`` times into ``dest``; copy r moves
-    the recording hour by r. The hour keeps two digits up to 99 (ALFA's flights are
-    recorded from 11 to 17 h), so names stay parseable; a clash with another flight's
-    name is an error."""
-    n = 0
-    for flight in sorted(p for p in processed.iterdir() if p.is_dir()):
+    the recording hour by r. Then ``extra`` more: every sixth flight, moved by
+    ``copies + 2`` hours. The hour keeps two digits up to 99 (ALFA's flights are
+    recorded from 11 to 17 h), so names stay parseable."""
+    flights = sorted(p for p in processed.iterdir() if p.is_dir())
+    for flight in flights:
         for r in range(copies):
-            m = _TIME.match(flight.name)
-            name = f"{m[1]}{int(m[2]) + r:02d}{m[3]}"
-            folder = dest / name
-            folder.mkdir(parents=True)
-            for f in flight.iterdir():
-                (folder / f.name.replace(flight.name, name, 1)).symlink_to(f.resolve())
-            n += 1
-    return n
+            _link(flight, dest, r)
+    for flight in flights[::6][:extra]:
+        _link(flight, dest, copies + 2)
+    return len(flights) * copies + min(extra, len(flights[::6]))
 
 
-def run(alfa: Path, config: Path, work: Path) -> tuple[float, Counter]:
-    """The wall time of ``snakemake all`` and the jobs it ran, counted per rule."""
-    cmd = [sys.executable, "-m", "snakemake", "all", "--cores", "2",
-           "--snakefile", str(ROOT / "Snakefile"), "--directory", str(work),
+def run(root: Path, alfa: Path, config: Path, work: Path, targets=("all",)
+        ) -> tuple[float, Counter]:
+    """The wall time of ``snakemake <targets>`` and the jobs it ran, counted per rule."""
+    python = root / ".venv/bin/python"
+    cmd = [str(python) if python.exists() else sys.executable, "-m", "snakemake", *targets,
+           "--cores", "2", "--snakefile", str(root / "Snakefile"), "--directory", str(work),
            "--configfile", str(config)]
     t = time.perf_counter()
     done = subprocess.run(cmd, env={**os.environ, "ALFA_DIR": str(alfa)},
@@ -67,25 +84,51 @@ def run(alfa: Path, config: Path, work: Path) -> tuple[float, Counter]:
     return wall, Counter(_FINISHED.findall(done.stderr))
 
 
+def job_stats(work: Path) -> dict[str, tuple[float, float]]:
+    """Per job with a Snakemake benchmark file (``detect/<method>`` or the rule): its
+    wall time, s, and its largest resident memory, MB (``max_rss``)."""
+    out = {}
+    for tsv in sorted((work / "results/benchmarks").rglob("*.tsv")):
+        with tsv.open() as f:
+            row = next(csv.DictReader(f, delimiter="\t"))
+        rss = row.get("max_rss", "NA")
+        out[str(tsv.relative_to(work / "results/benchmarks").with_suffix(""))] = (
+            float(row["s"]), float(rss) if rss != "NA" else float("nan"))
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--flights", type=int, nargs="*", default=[1, 2, 4])
     ap.add_argument("--settings", type=int, nargs="*", default=[1, 4, 16])
     ap.add_argument("--changed", action="store_true")
+    ap.add_argument("--extra", type=int, default=0)
+    ap.add_argument("--root", type=Path, default=Path(__file__).resolve().parent.parent)
+    ap.add_argument("--methods-of", type=Path,
+                    help="keep only the method runs of this checkout's config")
+    ap.add_argument("--targets", nargs="+", default=["all"],
+                    help="the rules to run instead of all")
     args = ap.parse_args()
+    root = args.root.resolve()
     processed = Path(os.environ["ALFA_DIR"]) / "processed"
-    base = yaml.safe_load((ROOT / "config/config.yaml").read_text())
-    found = sum(1 for p in processed.iterdir() if p.is_dir())
+    base = yaml.safe_load((root / "config/config.yaml").read_text())
+    if args.methods_of:
+        keep = yaml.safe_load((args.methods_of / "config/config.yaml").read_text())["methods"]
+        base["methods"] = {m: s for m, s in base["methods"].items() if m in keep}
+    memory = {}
     print("| case | flights found | method runs | wall s |")
     print("|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         config = tmp / "config.yaml"
         config.write_text(yaml.safe_dump(base))
+        once = tmp / "alfa"
+        found = replicate(processed, once / "processed", 1, args.extra)
         for k in args.flights:
             alfa = tmp / f"alfa{k}"
-            n = replicate(processed, alfa / "processed", k)
-            wall, _ = run(alfa, config, tmp / f"flights{k}")
+            n = replicate(processed, alfa / "processed", k, args.extra)
+            wall, _ = run(root, alfa, config, tmp / f"flights{k}", args.targets)
+            memory[f"flights x{k}"] = job_stats(tmp / f"flights{k}")
             print(f"| flights x{k} | {n} | {len(base['methods'])} | {wall:.1f} |", flush=True)
         for k in args.settings:
             swept = dict(base)
@@ -95,21 +138,25 @@ def main() -> None:
                     "false_alarm": 1e-4 * (i + 1)}} for i in range(k)}}
             config = tmp / f"config{k}.yaml"
             config.write_text(yaml.safe_dump(swept))
-            wall, _ = run(processed.parent, config, tmp / f"settings{k}")
+            wall, _ = run(root, once, config, tmp / f"settings{k}", args.targets)
             print(f"| glrt_arx settings x{k} | {found} | {len(swept['methods'])} | {wall:.1f} |",
                   flush=True)
         if args.changed:
             config = tmp / "changed.yaml"
             config.write_text(yaml.safe_dump(base))
-            wall, _ = run(processed.parent, config, tmp / "changed")
+            wall, _ = run(root, once, config, tmp / "changed", args.targets)
+            memory["all, from empty"] = job_stats(tmp / "changed")
             print(f"| all, before the change | {found} | {len(base['methods'])} | {wall:.1f} |")
             changed = copy.deepcopy(base)
             changed["methods"]["glrt_arx_chi2"]["params"]["false_alarm"] /= 2
             config.write_text(yaml.safe_dump(changed))
-            wall, jobs = run(processed.parent, config, tmp / "changed")
+            wall, jobs = run(root, once, config, tmp / "changed", args.targets)
             ran = ", ".join(f"{rule} {k}" for rule, k in sorted(jobs.items()))
             print(f"| all, after glrt_arx_chi2 changed ({ran}) | {found} | "
                   f"{len(base['methods'])} | {wall:.1f} |", flush=True)
+    for case, stats in memory.items():
+        print(f"\nJobs of {case}: wall s, peak resident MB")
+        print("\n".join(f"- {job}: {s:.2f} s, {mb:.0f} MB" for job, (s, mb) in stats.items()))
 
 
 if __name__ == "__main__":

@@ -31,5 +31,7 @@ rule manifest:
         strict=config["strict"],
     log:
         "results/logs/manifest.log",
+    benchmark:
+        "results/benchmarks/manifest.tsv"
     script:
         "../scripts/manifest.py"

@@ -15,6 +15,8 @@ rule inject:
         processed=INJECTED_PROCESSED,
     log:
         "results/logs/inject.log",
+    benchmark:
+        "results/benchmarks/inject.tsv"
     script:
         "../scripts/inject.py"
 
@@ -51,6 +53,8 @@ rule detectability:
         methods=DETECTORS,
     log:
         "results/logs/detectability.log",
+    benchmark:
+        "results/benchmarks/detectability.tsv"
     script:
         "../scripts/detectability.py"
 
@@ -73,5 +77,7 @@ rule isolation:
         methods=DETECTORS,
     log:
         "results/logs/isolation.log",
+    benchmark:
+        "results/benchmarks/isolation.tsv"
     script:
         "../scripts/isolation.py"

@@ -36,6 +36,8 @@ rule paper_sources:
                         category="Manuscript"),
     log:
         "results/logs/paper_sources.log",
+    benchmark:
+        "results/benchmarks/paper_sources.tsv"
     script:
         "../scripts/paper.py"
 

@@ -14,5 +14,7 @@ rule provenance:
         unchecked=["results/rerun/*.rrd", "results/runtime/*"],
     log:
         "results/logs/provenance.log",
+    benchmark:
+        "results/benchmarks/provenance.tsv"
     script:
         "../scripts/provenance.py"

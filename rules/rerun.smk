@@ -13,6 +13,8 @@ rule rerun_logs:
         methods=json.dumps(config["methods"], sort_keys=True),
     log:
         "results/logs/rerun_logs.log",
+    benchmark:
+        "results/benchmarks/rerun_logs.tsv"
     script:
         "../scripts/rerun_logs.py"
 

@@ -16,6 +16,8 @@ rule sweep:
         subset=PRIMARY,
     log:
         "results/logs/sweep.log",
+    benchmark:
+        "results/benchmarks/sweep.tsv"
     script:
         "../scripts/sweep.py"
 
@@ -33,6 +35,8 @@ rule flight_figures:
                subcategory=figure_fault_class),
     log:
         "results/logs/flight_figures.log",
+    benchmark:
+        "results/benchmarks/flight_figures.tsv"
     script:
         "../scripts/flight_figures.py"
 

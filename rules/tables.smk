@@ -25,6 +25,8 @@ rule tables:
         deadline_s=config["scoring"]["deadline_s"],
     log:
         "results/logs/tables.log",
+    benchmark:
+        "results/benchmarks/tables.tsv"
     script:
         "../scripts/tables.py"
 
@@ -43,6 +45,8 @@ rule per_flight:
         deadline_s=config["scoring"]["deadline_s"],
     log:
         "results/logs/per_flight.log",
+    benchmark:
+        "results/benchmarks/per_flight.tsv"
     script:
         "../scripts/per_flight.py"
 
@@ -60,6 +64,8 @@ rule runtime:
                     category="Runtime"),
     log:
         "results/logs/runtime.log",
+    benchmark:
+        "results/benchmarks/runtime.tsv"
     script:
         "../scripts/runtime.py"
 
@@ -84,6 +90,8 @@ rule deadline:
         subset=PRIMARY,
     log:
         "results/logs/deadline.log",
+    benchmark:
+        "results/benchmarks/deadline.tsv"
     script:
         "../scripts/deadline.py"
 
@@ -100,6 +108,8 @@ rule leakage:
                     category="Leakage audit"),
     log:
         "results/logs/leakage.log",
+    benchmark:
+        "results/benchmarks/leakage.tsv"
     script:
         "../scripts/leakage.py"
 
@@ -120,5 +130,7 @@ rule ceiling:
         margin_s=config["calibration"]["margin_s"],
     log:
         "results/logs/ceiling.log",
+    benchmark:
+        "results/benchmarks/ceiling.tsv"
     script:
         "../scripts/ceiling.py"
