@@ -26,10 +26,19 @@ records say, per fold, which configuration scored and how many were tried
 
 Every candidate must read the same signals and give the same channels; a grid that
 changes them (a different set of models) is refused.
+
+Across the workflow's folds, one detector is fitted once per scored date, and the
+inner fit without dates :math:`\{o, d\}` comes twice: scoring :math:`o` with :math:`d`
+held out, and scoring :math:`d` with :math:`o` held out. Each inner fit is therefore
+kept, keyed by the candidate and the exact data it was fitted on (a digest of every
+segment's samples), and given again when the same data comes back; fits are
+deterministic, so this changes no result, and halves the inner fits.
 """
 
 from __future__ import annotations
 
+import copy
+import hashlib
 import itertools
 import logging
 import math
@@ -44,6 +53,14 @@ from .base import Detector, Labelled
 __all__ = ["NestedSelection", "held_out_right"]
 
 log = logging.getLogger(__name__)
+
+
+def _digest(s: Sampled) -> bytes:
+    """What identifies a segment's data: its flight, times, values and freshness."""
+    h = hashlib.blake2b(s.flight.encode(), digest_size=16)
+    for a in (s.t, s.x, s.fresh):
+        h.update(np.ascontiguousarray(a).data)
+    return h.digest()
 
 
 def held_out_right(first_alarm_s: float | None, onset_s: float | None,
@@ -83,6 +100,10 @@ class NestedSelection(Detector):
         the training dates without which it could not be fitted.
     base_ : Detector
         The base detector with ``chosen_``, fitted on every training flight.
+    inner_fits_ : dict
+        Every inner fit made so far, by candidate and data digest (the fitted detector,
+        or the ``ValueError`` it could not be fitted with); kept across :meth:`fit`
+        calls, since the folds repeat half of them (module docstring).
     """
 
     calibrated = True
@@ -172,7 +193,9 @@ class NestedSelection(Detector):
             raise ValueError(f"nested selection needs training flights of two dates or more; "
                              f"found {len(dates)}")
         inner = []
-        for values, det in zip(self.candidates(), made, strict=True):
+        digest = [_digest(f.sampled) for f in segments]
+        kept = self.__dict__.setdefault("inner_fits_", {})
+        for i, (values, base) in enumerate(zip(self.candidates(), made, strict=True)):
             right = scored = 0
             unfit = []
             for d in dates:
@@ -180,12 +203,17 @@ class NestedSelection(Detector):
                         if fd == d and self._scored(f)]
                 if not held:
                     continue
-                try:
-                    det.fit(self._free([f for f, fd in zip(segments, date, strict=True)
-                                        if fd != d]))
-                except ValueError as e:       # too little data without d: d goes unscored
+                key = (i, tuple(h for h, fd in zip(digest, date, strict=True) if fd != d))
+                if key not in kept:
+                    try:
+                        kept[key] = copy.deepcopy(base.fit(self._free(
+                            [f for f, fd in zip(segments, date, strict=True) if fd != d])))
+                    except ValueError as e:   # too little data without d: d goes unscored
+                        kept[key] = e
+                det = kept[key]
+                if isinstance(det, ValueError):
                     log.info("nested selection: %s cannot be fitted without %s: %s",
-                             values, d, e)
+                             values, d, det)
                     unfit.append(d)
                     continue
                 for f in held:
