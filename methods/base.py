@@ -328,6 +328,15 @@ class Fork:
                 and np.array_equal(s.x[:k], self.sampled.x, equal_nan=True)
                 and np.array_equal(s.fresh[:k], self.sampled.fresh))
 
+    def continued(self, detector: Detector, s: Sampled, probes: bool
+                  ) -> tuple[np.ndarray, dict]:
+        """``detector``'s scores and probes over ``s`` (a flight :meth:`shared_by`
+        accepts), these steps' included, running only the steps after them."""
+        more, more_kept = detector.run(s, probes, start=self.sampled.t.size,
+                                       state=self.state)
+        return (np.vstack([self.score, more]),
+                {n: np.concatenate([self.probes[n], v]) for n, v in more_kept.items()})
+
 
 def forks(detector: Detector, flight: Flight, times_s, probes: bool = False
           ) -> dict[float, Fork]:
@@ -335,18 +344,15 @@ def forks(detector: Detector, flight: Flight, times_s, probes: bool = False
     each), each run continuing the one before: a :class:`Fork` per time. Empty when the
     detector cannot fork (:meth:`Detector.snapshot` is None)."""
     s = sample(flight, detector.signals(), detector.rate_hz)
-    out, state, score, kept = {}, None, np.empty((0, len(detector.channels()))), {}
+    out, last = {}, None
     for t_s in sorted(set(times_s)):
         head = s.before(t_s)
-        done = score.shape[0]
-        more, more_kept = (detector.run(head, probes) if state is None else
-                           detector.run(head, probes, start=done, state=state))
-        score = np.vstack([score, more])
-        kept = {n: np.concatenate([kept.get(n, np.empty(0)), v]) for n, v in more_kept.items()}
+        score, kept = (detector.run(head, probes) if last is None
+                       else last.continued(detector, head, probes))
         state = detector.snapshot()
         if state is None:
             return {}
-        out[t_s] = Fork(head, state, score, kept, probes)
+        out[t_s] = last = Fork(head, state, score, kept, probes)
     return out
 
 
@@ -361,10 +367,7 @@ def run_detector(detector: Detector, flight: Flight, probes: bool = False,
     a fork without the probes asked for) runs from a fresh state."""
     s = sample(flight, detector.signals(), detector.rate_hz)
     if fork is not None and fork.shared_by(s, probes):
-        k = fork.sampled.t.size
-        more, more_kept = detector.run(s, probes, start=k, state=fork.state)
-        score = np.vstack([fork.score, more])
-        kept = {n: np.concatenate([fork.probes[n], v]) for n, v in more_kept.items()}
+        score, kept = fork.continued(detector, s, probes)
     else:
         score, kept = detector.run(s, probes)
     skipped = skipped_channels(detector, not_measured(flight, detector.signals()))
