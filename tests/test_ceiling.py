@@ -18,6 +18,31 @@ def test_auc_counts_pairs_and_ties():
     assert auc == 0.5 and lo < 0.5 < hi
 
 
+def _plain_auc_interval(fault, free, seed=0, n_boot=2000):
+    """The bootstrap as first written: every resample drawn and compared pair by pair."""
+    def auc(a, b):
+        d = a[:, None] - b[None, :]
+        return float(np.mean((d > 0) + 0.5 * (d == 0)))
+
+    rng = np.random.default_rng(seed)
+    boots = [auc(rng.choice(fault, fault.size), rng.choice(free, free.size))
+             for _ in range(n_boot)]
+    lo, hi = np.quantile(boots, [0.025, 0.975])
+    return auc(fault, free), float(lo), float(hi)
+
+
+@pytest.mark.parametrize("sizes", [(1, 5), (2, 2), (7, 30), (23, 47)])
+@pytest.mark.parametrize("decimals", [None, 0])
+def test_the_resample_counts_give_the_plain_bootstrap_to_the_bit(sizes, decimals):
+    rng = np.random.default_rng(sum(sizes))
+    fault, free = rng.normal(0.5, 1.0, sizes[0]), rng.normal(0.0, 1.0, sizes[1])
+    if decimals is not None:          # ties between and within the sets
+        fault, free = fault.round(decimals), free.round(decimals)
+    assert auc_interval(fault, free) == _plain_auc_interval(fault, free)
+    assert auc_interval(fault, free, seed=3, n_boot=50) == _plain_auc_interval(
+        fault, free, seed=3, n_boot=50)
+
+
 @pytest.fixture(scope="module")
 def flights(corpus):
     return {p.name: load_flight(p) for p in sorted(corpus.iterdir())}
