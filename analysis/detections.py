@@ -48,15 +48,18 @@ from .provenance import provenance, read_table, run_provenance, stamp
 from .scoring import flight_outcome
 from .traces import write_trace
 
-__all__ = ["RUN_RECORD", "calibration_failure", "detect_all", "detection_record",
-           "iter_records", "read_failures", "read_records", "read_run_record", "record_paths",
-           "write_detections", "write_record"]
+__all__ = ["INJECTED_RECORDS", "RUN_RECORD", "calibration_failure", "count_records",
+           "detect_all", "detection_record", "iter_records", "read_failures", "read_records",
+           "read_run_record", "record_paths", "write_detections", "write_record"]
 
 log = logging.getLogger(__name__)
 
 #: in an injected-detections folder, what its records share: each fold's calibration
 #: and the run's provenance, written once instead of in each of thousands of records
 RUN_RECORD = "run.json"
+#: in an injected-detections folder, its records: one JSON object a line, by flight name
+#: (thousands of small files cost more to write, list and checksum than the records)
+INJECTED_RECORDS = "records.jsonl"
 
 
 def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest: pd.DataFrame,
@@ -291,19 +294,33 @@ def read_records(folders) -> list[dict]:
 
 
 def record_paths(folder) -> list[Path]:
-    """The record files of a detections folder, by name (not its :data:`RUN_RECORD`)."""
+    """The record files of a real flights' detections folder, by name."""
     return [p for p in sorted(Path(folder).glob("*.json")) if p.name != RUN_RECORD]
 
 
 def iter_records(folders) -> Iterator[dict]:
     """The records of :func:`read_records`, one at a time, so that memory does not
     grow with the injected grid (145,000 records at 16 times ALFA's flights). An
-    injected record's ``calibration`` names its fold only, and its ``provenance``
-    the flight's checksum: the rest is its folder's :data:`RUN_RECORD`
-    (:func:`read_run_record`)."""
+    injected-detections folder holds its records in :data:`INJECTED_RECORDS`; such a
+    record's ``calibration`` names its fold only, and its ``provenance`` the flight's
+    checksum: the rest is its folder's :data:`RUN_RECORD` (:func:`read_run_record`)."""
     for d in folders:
+        lines = Path(d) / INJECTED_RECORDS
+        if lines.is_file():
+            with lines.open() as f:
+                yield from map(json.loads, f)
+            continue
         for p in record_paths(d):
             yield json.loads(p.read_text())
+
+
+def count_records(folder) -> int:
+    """How many records a detections folder holds, without reading them."""
+    lines = Path(folder) / INJECTED_RECORDS
+    if lines.is_file():
+        with lines.open("rb") as f:
+            return sum(1 for _ in f)
+    return len(record_paths(folder))
 
 
 def read_run_record(folder) -> dict:
@@ -347,8 +364,10 @@ def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
     manifest (in ``flights``) are scored in the same pass, each by the fit of its
     source's fold (one fit per fold for both), and their records and failures are
     written to the folder, without traces: a record holds all that is read of them.
-    Their calibration blocks and provenance, the same for every flight of a fold,
-    are written once, to the folder's :data:`RUN_RECORD`, which the records name.
+    The records go to :data:`INJECTED_RECORDS`, a line each in the order of their
+    flights' names. Their calibration blocks and provenance, the same for every flight
+    of a fold, are written once, to the folder's :data:`RUN_RECORD`, which the records
+    name.
     """
     extra, folder = injected if injected is not None else (manifest.iloc[:0], None)
     if recordings is not None:
@@ -360,11 +379,13 @@ def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
     scored = pd.concat([manifest, extra], ignore_index=True) if len(extra) else manifest
     grid = set(extra["flight"])
     run = {"folds": {}, "calibration_sha256": {}}
+    lines = {}
     for record, trace in detect_all(method, spec, flights, scored, calibration, failures,
                                     calibrate_on=manifest):
         name = record["flight"]
         if name in grid:
-            write_record(_referencing(record, run), folder / f"{name}.json")
+            lines[name] = json.dumps(_referencing(record, run), sort_keys=True,
+                                     allow_nan=False, default=list)
         else:
             write_record(record, out / f"{name}.json")
             write_trace(trace, traces / f"{name}.npz", record["provenance"])
@@ -382,5 +403,6 @@ def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
                                                                index=False)
             stamp(where / "failures.csv", prov)
     if folder is not None:
+        (folder / INJECTED_RECORDS).write_text("".join(lines[n] + "\n" for n in sorted(lines)))
         run.setdefault("provenance", provenance(spec, {}))   # no injected flight scored
         write_record(run, folder / RUN_RECORD)

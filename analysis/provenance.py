@@ -181,8 +181,10 @@ def _run_file_of(path: Path) -> tuple[dict, str]:
 def read_provenance(path: str | Path) -> dict:
     """The provenance of a result file: its own (see :func:`stamp`), or for a CSV,
     Markdown, HTML or LaTeX table that of the run file listing it, whose checksum it must
-    still match where one is recorded. An injected flight's record names the run record
-    of its folder, which holds the rest (``analysis.detections.RUN_RECORD``)."""
+    still match where one is recorded. The injected flights' records (``.jsonl``) name
+    the run record of their folder, which holds the rest
+    (``analysis.detections.RUN_RECORD``): their provenance is the run's, with every
+    flight's checksum and those of every fold's calibration flights."""
     path = Path(path)
     match path.suffix:
         case ".csv" | ".tex" | ".md" | ".html":
@@ -203,16 +205,21 @@ def read_provenance(path: str | Path) -> dict:
             with np.load(path) as z:
                 return json.loads(str(z["provenance"][0]))
         case ".json":
-            record = json.loads(path.read_text())
-            prov = record["provenance"]
-            if "run" not in prov:
-                return prov
-            # an injected flight's record: the run's provenance is its folder's run record
-            run = json.loads((path.parent / prov["run"]).read_text())
-            fold = (record.get("calibration") or {}).get("fold")
+            return json.loads(path.read_text())["provenance"]
+        case ".jsonl":
+            # injected flights' records: the run's provenance is their folder's run
+            # record; each names its flight's checksum, and its fold's calibration there
+            with path.open() as f:
+                records = [json.loads(line) for line in f]
+            runs = {r["provenance"]["run"] for r in records}
+            if len(runs) != 1:
+                raise ValueError(f"{path}: its records name {len(runs)} run records, not one")
+            run = json.loads((path.parent / runs.pop()).read_text())
             return {**run["provenance"], "inputs": {
-                "flight_sha256": prov["flight_sha256"],
-                "calibration_sha256": run["calibration_sha256"].get(fold, {})}}
+                "flight_sha256": {r["flight"]: r["provenance"]["flight_sha256"]
+                                  for r in records},
+                "calibration_sha256": {f: sha for fold in run["calibration_sha256"].values()
+                                       for f, sha in fold.items()}}}
         case ".rrd":       # the recording's property (rerun_log.write_rerun_log)
             import rerun.chunk as rc
             for chunk in rc.RrdReader(path).store().stream().to_chunks():

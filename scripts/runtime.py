@@ -2,7 +2,7 @@
 
 from pathlib import Path
 
-from alfa_bench.analysis.detections import record_paths
+from alfa_bench.analysis.detections import count_records
 from alfa_bench.analysis.logs import log_to
 from alfa_bench.analysis.provenance import run_provenance, stamp
 from alfa_bench.analysis.render import markdown_html
@@ -12,7 +12,7 @@ from alfa_bench.data import read_manifest
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 # one record per flight scored: counted, not read (the injected grid has thousands)
-flights, injected = ({Path(d).name: len(record_paths(d)) for d in folders}
+flights, injected = ({Path(d).name: count_records(d) for d in folders}
                      for folders in (sm.input.detections, sm.input.injected))
 table = runtime_table(sm.input.benchmarks, flights, injected)
 table.to_csv(sm.output.csv, index=False)

@@ -16,7 +16,12 @@ from broken import GT, IMU, ROLL, _gap, _late_start, edit, set_cell, shift_time
 from loopback import make_archive, serve_archive
 from recordings import content
 
-from alfa_bench.analysis.detections import RUN_RECORD, iter_records, read_run_record
+from alfa_bench.analysis.detections import (
+    INJECTED_RECORDS,
+    RUN_RECORD,
+    iter_records,
+    read_run_record,
+)
 from alfa_bench.analysis.provenance import RUN_FILE, read_provenance, read_table
 from alfa_bench.analysis.traces import read_trace
 from alfa_bench.data.synthetic import write_flight
@@ -178,6 +183,13 @@ def test_the_injected_grid_is_scored_and_isolated(runs, corpus):
     run = read_run_record(folder)
     records = list(iter_records([folder]))
     assert len(records) == len(injected)
+    assert [r["flight"] for r in records] == sorted(injected["flight"])
+    # one JSON object a line, as pandas and DuckDB read it by default
+    import duckdb
+    import pandas as pd
+    lines = folder / INJECTED_RECORDS
+    assert pd.read_json(lines, lines=True)["flight"].tolist() == sorted(injected["flight"])
+    assert len(duckdb.sql(f"select flight from read_json('{lines}')").fetchall()) == len(records)
     sha = dict(zip(injected["flight"], injected["sha256"], strict=True))
     real = {r["flight"]: r for r in iter_records([out / "detections/glrt_arx"])}
     source = dict(zip(injected["flight"], injected["fault_source"], strict=True))
@@ -260,9 +272,10 @@ def test_every_result_file_records_its_provenance(runs, corpus):
              and p not in (work / "results/injected/flights.csv", work / RUN_FILE)
              and p.name != RUN_RECORD]     # what the injected records share: read through them
     files += [work / "paper/build/paper.md", work / "paper/build/results.tex"]
-    assert {p.suffix for p in files} == {".csv", ".md", ".tex", ".json", ".npz", ".png", ".rrd",
-                                         ".parquet", ".html"}
+    assert {p.suffix for p in files} == {".csv", ".md", ".tex", ".json", ".jsonl", ".npz", ".png",
+                                         ".rrd", ".parquet", ".html"}
     flights = {p.name for p in corpus.iterdir()}
+    injected = set(read_table(work / "results/injected/flights.csv")["flight"])
     for path in files:
         prov = read_provenance(path)
         assert prov["code"]["version"] and "git_commit" in prov["code"], path
@@ -271,6 +284,10 @@ def test_every_result_file_records_its_provenance(runs, corpus):
         if path.suffix in (".json", ".npz"):       # one flight's run, and its calibration
             assert len(inputs["flight_sha256"]) == 64, path
             checksums = inputs["calibration_sha256"]
+        elif path.suffix == ".jsonl":       # every injected flight's run, and the folds'
+            checksums = inputs["flight_sha256"]
+            assert set(checksums) == injected, path
+            assert flights >= set(inputs["calibration_sha256"]), path
         else:                                    # every flight, and the calibration folds
             checksums = inputs["flight_sha256"]
             assert flights <= set(checksums), path
