@@ -321,11 +321,13 @@ def load_flight(path: str | Path) -> Flight:
 
 
 def assemble_flight(path: str | Path, t0_ns: int, topics: dict[str, Topic],
-                    repairs=()) -> Flight:
+                    repairs=(), ground_truth: Fault | None = None) -> Flight:
     """The :class:`Flight` of already-read ``topics`` (times on the clock of
     ``t0_ns``), its ground truth read from them: what :func:`load_flight` returns
     after parsing, and what the parsed-flight cache (:mod:`.cache`) and in-memory
-    injection (:mod:`.inject`) rebuild."""
+    injection (:mod:`.inject`) rebuild. In-memory injection, which writes the
+    ground-truth topic from a known fault, gives that fault as ``ground_truth``,
+    so that the topic's frame need not be built to read it back."""
     path = Path(path)
     name = path.name
     meta = parse_flight_name(name)
@@ -339,7 +341,8 @@ def assemble_flight(path: str | Path, t0_ns: int, topics: dict[str, Topic],
         emergency_trajectory=label.endswith("with_emr_traj"),
         t0_ns=t0_ns,
         duration_s=duration,
-        fault=_ground_truth(name, label, topics),
+        fault=(_ground_truth(name, label, topics) if ground_truth is None
+               else ground_truth),
         topics=topics,
         repairs=tuple(repairs),
     )

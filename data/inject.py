@@ -50,7 +50,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import AlfaDataError
-from .flight import Flight, Topic, assemble_flight, load_flight, parse_flight_name
+from .flight import Fault, Flight, Topic, assemble_flight, load_flight, parse_flight_name
 from .signals import SIGNALS, not_measured
 
 log = logging.getLogger("alfa_bench.data")
@@ -149,60 +149,68 @@ def inject_flight(source: Flight, processed: str | Path, sensor: str, kind: str,
 
     The kept topics are re-timed on the new flight's clock (its first record), as
     reading the written files would; their frames are the source's, unchanged but
-    for the corrupted column, which becomes float64 as written by ``repr``.
+    for the corrupted column, which becomes float64 as written by ``repr``. The
+    corrupted topic's frame and the ground truth's are built when first asked for:
+    the numbers they hold, and the fault, are handed over as reading them would give.
     """
     topic = _check_spec(source, sensor, kind, onset_s)
     sig = SIGNALS[sensor]
     name = injected_name(source.id, sensor, kind, magnitude, onset_s)
     keep = [t for t in source.topics if topics is None or t in topics or t == sig.topic]
-    # the record times in ns, exactly: |t| < 1e4 s keeps t * 1e9 within float64's integers
-    t_ns = {t: source.t0_ns + np.round(source.topics[t].t * 1e9).astype(np.int64)
-            for t in keep}
     onset_ns = source.t0_ns + round(onset_s * 1e9)
     values = topic.values(sig.column)
     span = float(values.max() - values.min())
     rng = np.random.default_rng([seed, zlib.crc32(name.encode())])
-    times = t_ns[sig.topic]
+    # the record times in ns, exactly: |t| < 1e4 s keeps t * 1e9 within float64's integers
+    times = source.t0_ns + np.round(topic.t * 1e9).astype(np.int64)
     first = int(np.searchsorted(times, onset_ns))
     corrupted = values.copy()
     # the operations of _corrupt, in the same order on the same doubles, over the rows
     corrupted[first:] = _corrupt(kind, values[first:], float(values[first - 1]),
                                  (times[first:] - onset_ns) * 1e-9, magnitude, span, rng)
-    frame = topic.frame.copy(deep=False)
-    frame[sig.column] = corrupted
-    # the other topics are the source's, frames and all (renamed, below)
-    frames = {sig.topic: frame}
-    rows = np.zeros(len(times) - first, dtype=np.intp)
-    gt = pd.DataFrame({"field.data": np.ones(len(rows), np.int64),
-                       "field.sensor": _text(sensor).take(rows),
-                       "field.kind": _text(kind).take(rows),
-                       "field.magnitude": np.full(len(rows), float(magnitude)),
-                       "field.source": _text(source.id).take(rows)})
-    # what values() would parse from the new frames, handed over as the cache does
-    numbers = {GROUND_TRUTH: {"field.data": np.ones(len(rows)),
-                              "field.magnitude": np.full(len(rows), float(magnitude))},
-               sig.topic: {sig.column: corrupted.copy()}}
-    for cached in numbers.values():
-        for v in cached.values():
-            v.setflags(write=False)
-    t_ns[GROUND_TRUTH], frames[GROUND_TRUTH] = times[first:], gt
-    lines = {t: source.topics[t].lines for t in keep}
-    lines[GROUND_TRUTH] = np.arange(2, len(times) - first + 2)
-    t0 = min(int(v[0]) for v in t_ns.values())
+    corrupted.setflags(write=False)
+    t0 = min(source.t0_ns + round(float(source.topics[t].t[0]) * 1e9) for t in keep)
+    if t0 == source.t0_ns:      # the same clock: the times are the source's, to the bit
+        clock = {t: source.topics[t].t for t in keep} | {GROUND_TRUTH: topic.t[first:]}
+    else:
+        clock = {t: (source.t0_ns + np.round(source.topics[t].t * 1e9).astype(np.int64) - t0)
+                 * 1e-9 for t in keep} | {GROUND_TRUTH: (times[first:] - t0) * 1e-9}
+    rows = len(times) - first
 
-    def renamed(t: str) -> Topic:
-        if t in source.topics and t != sig.topic:
-            # the source's frame, so its parsed values too: replace() passes its cache on,
-            # and the grid's other flights from this source fill it
-            return replace(source.topics[t], flight=name, file=f"{name}-{t}.csv",
-                           t=(t_ns[t] - t0) * 1e-9)
-        return Topic(name, t, f"{name}-{t}.csv", (t_ns[t] - t0) * 1e-9, frames[t], lines[t],
-                     numbers[t])
-    new = {t: renamed(t) for t in sorted(t_ns)}
+    def corrupted_frame() -> pd.DataFrame:
+        frame = topic.frame.copy(deep=False)
+        frame[sig.column] = corrupted
+        return frame
+
+    def ground_truth() -> pd.DataFrame:
+        repeat = np.zeros(rows, dtype=np.intp)
+        return pd.DataFrame({"field.data": np.ones(rows, np.int64),
+                             "field.sensor": _text(sensor).take(repeat),
+                             "field.kind": _text(kind).take(repeat),
+                             "field.magnitude": np.full(rows, float(magnitude)),
+                             "field.source": _text(source.id).take(repeat)})
+
+    data, size = np.ones(rows), np.full(rows, float(magnitude))
+    for v in (data, size):
+        v.setflags(write=False)
+    new = {t: replace(source.topics[t], flight=name, file=f"{name}-{t}.csv", t=clock[t])
+           for t in keep if t != sig.topic}
+    # what values() would parse from the new frames, handed over as the cache does
+    new[sig.topic] = Topic(name, sig.topic, f"{name}-{sig.topic}.csv", clock[sig.topic],
+                           cache(corrupted_frame), topic.lines,
+                           {**topic._cache, sig.column: corrupted})
+    new[GROUND_TRUTH] = Topic(name, GROUND_TRUTH, f"{name}-{GROUND_TRUTH}.csv",
+                              clock[GROUND_TRUTH], cache(ground_truth),
+                              np.arange(2, rows + 2),
+                              {"field.data": data, "field.magnitude": size})
+    fault = Fault("sensor", float(clock[GROUND_TRUTH][0]), float(clock[GROUND_TRUTH][-1]),
+                  (GROUND_TRUTH,), {GROUND_TRUTH: (1,)}, sensor, kind, float(magnitude),
+                  source.id)
     files = {source.topics[t].file: f"{name}-{t}.csv" for t in keep}
     repairs = [files[r.split(":", 1)[0]] + ":" + r.split(":", 1)[1]
                for r in source.repairs if r.split(":", 1)[0] in files]
-    return assemble_flight(Path(processed) / name, t0, new, repairs)
+    return assemble_flight(Path(processed) / name, t0, {t: new[t] for t in sorted(new)},
+                           repairs, ground_truth=fault)
 
 
 @cache

@@ -115,6 +115,22 @@ def test_an_injected_flight_in_memory_is_its_csv_copy_read_back(corpus, tmp_path
     assert np.array_equal(a.score, b.score, equal_nan=True)
 
 
+@pytest.mark.parametrize("sensor", ["pitch", "pitch_rate"])
+def test_an_injected_flight_without_the_first_topic_is_retimed_as_read_back(corpus, tmp_path,
+                                                                           sensor):
+    """Left without the topic that starts the source's clock, the flight starts later:
+    every time moves, as reading the written files moves it."""
+    source = load_flight(corpus / SOURCE)
+    earliest = min(source.topics, key=lambda t: float(source.topics[t].t[0]))
+    topics = {"mavros-nav_info-pitch", "mavros-imu-data"}
+    assert earliest not in topics
+    spec = (sensor, "drift", 0.5, 40.0)
+    written = load_flight(inject_sensor_fault(source, tmp_path, *spec, topics=topics))
+    built = inject_flight(source, tmp_path, *spec, topics=topics)
+    assert built.t0_ns != source.t0_ns
+    assert_same_flight(built, written)
+
+
 def test_the_grid_builds_each_flight_when_looked_up_and_keeps_none(corpus, tmp_path):
     """Names and checksums come from the specs alone; a lookup builds the flight that
     inject_flight builds, afresh each time (a large grid is never held in memory)."""
