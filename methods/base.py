@@ -78,6 +78,10 @@ class Detector(ABC):
     #: whether each output depends on the data up to then only; a detector that is
     #: not may serve only as a reference row (``role: reference`` in the config)
     causal: bool = True
+    #: hyper-parameters that set only the thresholds, from what :meth:`fit` learned:
+    #: whatever their values, the scores and all else it learns are the same, and
+    #: :meth:`rethreshold` sets the thresholds for new values without fitting again
+    threshold_params: tuple[str, ...] = ()
 
     def get_params(self) -> dict:
         """Hyper-parameters by name, as passed to ``__init__``."""
@@ -111,6 +115,12 @@ class Detector(ABC):
         if not hasattr(self, attribute):
             raise NotFittedError(f"{type(self).__name__} is calibrated: call fit() on "
                                  "fault-free segments before running it")
+
+    def rethreshold(self) -> Detector:
+        """Set the thresholds again from what :meth:`fit` learned, for the current
+        values of :attr:`threshold_params`; return self. Raise ``ValueError`` where
+        :meth:`fit` would. Only a detector that declares ``threshold_params`` has it."""
+        raise NotImplementedError(f"{type(self).__name__} declares no threshold_params")
 
     @abstractmethod
     def thresholds(self) -> np.ndarray:

@@ -14,7 +14,8 @@ and raises ``AssertionError`` where the contract fails:
 - probes are named once and change nothing; a batch ``run`` equals stepping
   ``update`` (scores to rounding, so the same alarms); runs are deterministic, and
   ``reset`` forgets the previous flight; a run continued from a snapshot (forked)
-  equals the run from t = 0;
+  equals the run from t = 0; where hyper-parameters set only the thresholds,
+  re-thresholding a fit for new values equals fitting with them;
 - it is causal: changing the data after time *t* changes no output before *t*.
 
 A plugin's own tests run them all with one decorator::
@@ -203,6 +204,26 @@ def check_forked_run_equals_run(detector: Detector) -> None:
     assert not np.array_equal(whole.score, run_detector(d, flight).score, equal_nan=True)
 
 
+def check_rethreshold_equals_fit(detector: Detector) -> None:
+    """For each of its :attr:`~.base.Detector.threshold_params`, a fitted detector given
+    another value and :meth:`~.base.Detector.rethreshold` equals one fitted with it:
+    what fit learned, and the run. (A detector that declares none is skipped.)"""
+    if not detector.threshold_params:
+        _skip("no threshold_params")
+    d = _fitted(detector)
+    for name in detector.threshold_params:
+        value = getattr(d, name)
+        other = value / 2 if isinstance(value, float) else value
+        refit = _fit(type(d)(**{**d.get_params(), name: other}))
+        moved = copy.deepcopy(d)
+        setattr(moved, name, other)
+        assert moved.rethreshold() is moved
+        assert moved.fitted() == refit.fitted(), name
+        _assert_same(run_detector(moved, _flight()), run_detector(refit, _flight()))
+        if other != value:       # the value must reach the thresholds
+            assert not np.array_equal(moved.thresholds(), d.thresholds()), name
+
+
 def check_deterministic(detector: Detector) -> None:
     d, flight = _fitted(detector), _flight()
     _assert_same(run_detector(d, flight), run_detector(d, flight))
@@ -270,6 +291,7 @@ CHECKS = (
     check_probes_are_named_once_and_do_not_change_the_run,
     check_batch_run_equals_streaming,
     check_forked_run_equals_run,
+    check_rethreshold_equals_fit,
     check_deterministic,
     check_reset_forgets_the_previous_flight,
     check_causal,

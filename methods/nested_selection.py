@@ -32,7 +32,11 @@ inner fit without dates :math:`\{o, d\}` comes twice: scoring :math:`o` with :ma
 held out, and scoring :math:`d` with :math:`o` held out. Each inner fit is therefore
 kept, keyed by the candidate and the exact data it was fitted on (a digest of every
 segment's samples), and given again when the same data comes back; fits are
-deterministic, so this changes no result, and halves the inner fits.
+deterministic, so this changes no result, and halves the inner fits. Candidates that
+differ only in hyper-parameters that set the thresholds
+(:attr:`~.base.Detector.threshold_params`, such as a false-alarm rate) give the same
+scores: one of them is fitted and run, the others take its fit re-thresholded
+(:meth:`~.base.Detector.rethreshold`, which the contract checks against a fit).
 """
 
 from __future__ import annotations
@@ -61,6 +65,16 @@ def _digest(s: Sampled) -> bytes:
     for a in (s.t, s.x, s.fresh):
         h.update(np.ascontiguousarray(a).data)
     return h.digest()
+
+
+def _sharing(made: list[Detector]) -> list[list[int]]:
+    """The candidates by group, in grid order: those whose hyper-parameters differ in
+    :attr:`~.base.Detector.threshold_params` alone share their fits and scores."""
+    groups: dict[str, list[int]] = {}
+    for i, d in enumerate(made):
+        rest = {k: v for k, v in d.get_params().items() if k not in d.threshold_params}
+        groups.setdefault(repr(sorted(rest.items())), []).append(i)
+    return list(groups.values())
 
 
 def held_out_right(first_alarm_s: float | None, onset_s: float | None,
@@ -192,38 +206,34 @@ class NestedSelection(Detector):
         if len(dates) < 2:
             raise ValueError(f"nested selection needs training flights of two dates or more; "
                              f"found {len(dates)}")
-        inner = []
         digest = [_digest(f.sampled) for f in segments]
-        kept = self.__dict__.setdefault("inner_fits_", {})
-        for i, (values, base) in enumerate(zip(self.candidates(), made, strict=True)):
-            right = scored = 0
-            unfit = []
-            for d in dates:
-                held = [f for f, fd in zip(segments, date, strict=True)
-                        if fd == d and self._scored(f)]
-                if not held:
-                    continue
-                key = (i, tuple(h for h, fd in zip(digest, date, strict=True) if fd != d))
-                if key not in kept:
-                    try:
-                        kept[key] = copy.deepcopy(base.fit(self._free(
-                            [f for f, fd in zip(segments, date, strict=True) if fd != d])))
-                    except ValueError as e:   # too little data without d: d goes unscored
-                        kept[key] = e
-                det = kept[key]
-                if isinstance(det, ValueError):
-                    log.info("nested selection: %s cannot be fitted without %s: %s",
-                             values, d, det)
-                    unfit.append(d)
-                    continue
-                for f in held:
-                    score, _ = det.run(f.sampled)
-                    alarm = det.alarms(score).any(axis=1)
-                    first = float(f.t[np.argmax(alarm)]) if alarm.any() else None
-                    right += held_out_right(first, f.onset_s, self.deadline_s)
-                    scored += 1
-            inner.append({"values": values, "scored": scored, "right": right,
-                          "share": right / scored if scored else math.nan, "unfit": unfit})
+        tally = [{"scored": 0, "right": 0, "unfit": []} for _ in made]
+        for d in dates:
+            held = [f for f, fd in zip(segments, date, strict=True)
+                    if fd == d and self._scored(f)]
+            if not held:
+                continue
+            data = tuple(h for h, fd in zip(digest, date, strict=True) if fd != d)
+            training = [f for f, fd in zip(segments, date, strict=True) if fd != d]
+            for group in _sharing(made):
+                fits = {i: self._inner_fit(i, group[0], made, data, training) for i in group}
+                for i in group:
+                    if isinstance(fits[i], ValueError):
+                        log.info("nested selection: %s cannot be fitted without %s: %s",
+                                 self.candidates()[i], d, fits[i])
+                        tally[i]["unfit"].append(d)
+                live = [i for i in group if not isinstance(fits[i], ValueError)]
+                for f in held if live else ():
+                    # one run for the group: its members differ in their thresholds only
+                    score, _ = fits[live[0]].run(f.sampled)
+                    for i in live:
+                        alarm = fits[i].alarms(score).any(axis=1)
+                        first = float(f.t[np.argmax(alarm)]) if alarm.any() else None
+                        tally[i]["right"] += held_out_right(first, f.onset_s, self.deadline_s)
+                        tally[i]["scored"] += 1
+        inner = [{"values": values, "scored": t["scored"], "right": t["right"],
+                  "share": t["right"] / t["scored"] if t["scored"] else math.nan,
+                  "unfit": t["unfit"]} for values, t in zip(self.candidates(), tally, strict=True)]
         if not any(c["scored"] for c in inner):
             raise ValueError(f"nested selection of {self.detector!r}: no candidate could be "
                              "fitted and scored on any training date")
@@ -236,6 +246,29 @@ class NestedSelection(Detector):
                  "candidates)", self.detector, self.chosen_, inner[best]["right"],
                  inner[best]["scored"], len(inner))
         return self
+
+    def _inner_fit(self, i: int, first: int, made: list[Detector], data: tuple,
+                   training: list[Labelled]) -> Detector | ValueError:
+        """Candidate ``i`` fitted on ``training`` (whose digest is ``data``), or the
+        ``ValueError`` it cannot be fitted with; kept in :attr:`inner_fits_`. A
+        candidate that differs from candidate ``first`` of its group in
+        :attr:`~.base.Detector.threshold_params` alone is that fit, re-thresholded."""
+        kept = self.__dict__.setdefault("inner_fits_", {})
+        key = (i, data)
+        if key in kept:
+            return kept[key]
+        shared = kept.get((first, data)) if i != first else None
+        try:
+            if shared is None or isinstance(shared, ValueError):
+                kept[key] = copy.deepcopy(made[i].fit(self._free(training)))
+            else:
+                det = copy.deepcopy(shared)
+                for name in type(det).threshold_params:
+                    setattr(det, name, getattr(made[i], name))
+                kept[key] = det.rethreshold()
+        except ValueError as e:       # too little data without the date: it goes unscored
+            kept[key] = e
+        return kept[key]
 
     def fitted(self) -> dict:
         self._check_fitted("base_")

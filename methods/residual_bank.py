@@ -159,6 +159,7 @@ class ResidualBank(Detector):
     """
 
     calibrated = True
+    threshold_params = ("false_alarm",)
 
     def __init__(self, models=DEFAULT_MODELS, lags_s=(0.0, 0.5, 1.0, 2.0), window_s=1.0,
                  baseline_s=20.0, false_alarm=0.1, rate_hz=20.0):
@@ -294,8 +295,13 @@ class ResidualBank(Detector):
             for c, m in enumerate(self.models):
                 if np.isfinite(sc[:, c]).any():
                     self.maxima_[m["name"]].append(float(np.nanmax(sc[:, c])))
+        return self.rethreshold()
+
+    def rethreshold(self) -> ResidualBank:
+        r""":math:`\gamma_c` of (3) from the fitted maxima, for ``false_alarm``."""
+        self.__dict__.pop("gamma_", None)
         level = 1.0 - self.false_alarm / len(self.models)
-        self.gamma_ = {}
+        gamma = {}
         for name, maxima in self.maxima_.items():
             if len(maxima) < MIN_SEGMENTS:
                 raise ValueError(
@@ -303,7 +309,8 @@ class ResidualBank(Detector):
                     f"{len(maxima)} fault-free segments long enough to score "
                     f"({self.window_s + self.baseline_s + max(self.lags_s)} s); the "
                     f"extreme-value threshold needs at least {MIN_SEGMENTS}")
-            self.gamma_[name] = max(gumbel_threshold(maxima, level), 1e-9)   # (3)
+            gamma[name] = max(gumbel_threshold(maxima, level), 1e-9)          # (3)
+        self.gamma_ = gamma
         return self
 
     def fitted(self) -> dict:

@@ -32,3 +32,35 @@ def test_the_folds_share_inner_fits_and_get_what_fresh_fits_give(corpus_flights)
         made_fresh += len(fresh.inner_fits_)
     # each inner fit without two dates comes twice over the folds, and is made once
     assert 0 < len(shared.inner_fits_) < made_fresh
+
+
+def test_candidates_apart_in_thresholds_alone_share_one_fit(corpus_flights, monkeypatch):
+    """false_alarm sets the residual bank's thresholds only: the candidates that differ
+    in it alone are fitted and run once per inner fold, and choose what fitting each
+    apart chooses."""
+    from alfa_bench.methods.residual_bank import ResidualBank
+
+    date = {n: str(parse_flight_name(n)["date"]) for n in corpus_flights}
+    scored = sorted(set(date.values()))[0]
+    training = [f for n, f in corpus_flights.items() if date[n] != scored and f.fault is not None]
+    fits = []
+    real_fit = ResidualBank.fit
+    monkeypatch.setattr(ResidualBank, "fit",
+                        lambda self, s: fits.append(self.window_s) or real_fit(self, s))
+    nested = _nested()
+    nested.grid = {"window_s": [0.5, 1.0], "false_alarm": [0.05, 0.1, 0.2]}
+    segments = labelled_segments(nested, training)
+    shared = nested.fit(segments).fitted()
+    together = len(fits)
+    monkeypatch.setattr(ResidualBank, "threshold_params", ())
+    fits.clear()
+    apart = _nested()
+    apart.grid = nested.grid
+    assert apart.fit(segments).fitted() == shared
+    # apart: each of the 6 candidates per inner date that holds flights scored, and the
+    # last fit; together: one per window and date where that fit stands (the other
+    # members of a group whose first cannot be fitted are tried on their own)
+    held_dates, rest = divmod(len(fits) - 1, 6)
+    assert held_dates >= 2 and rest == 0
+    unfit = sum(len(c["unfit"]) for c in shared["inner"] if c["values"]["false_alarm"] == 0.05)
+    assert together == 2 * held_dates + 1 + 2 * unfit < len(fits)
