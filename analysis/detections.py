@@ -354,11 +354,14 @@ def read_failures(folders) -> list[pd.DataFrame]:
 def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
                      manifest: pd.DataFrame, calibration: dict, *, strict: bool, config: dict,
                      out: Path, traces: Path, recordings: Path | None = None,
+                     panels: Path | None = None,
                      injected: tuple[pd.DataFrame, Path] | None = None) -> None:
     """Run :func:`detect_all` and write ``out/<flight>.json``, ``traces/<flight>.npz``
     and ``out/failures.csv`` (the flights excluded, empty when ``strict``, which
     raises instead), each with its provenance; with ``recordings``, also the method's
-    part of each flight's rerun recording there (:func:`~.rerun_log.write_rerun_part`).
+    part of each flight's rerun recording there (:func:`~.rerun_log.write_rerun_part`),
+    and with ``panels`` its panel of each flight's figure there
+    (:class:`~.figures.FlightPanel`, ``<flight>.png``).
 
     With ``injected`` (its manifest, and a folder), the injected flights of that
     manifest (in ``flights``) are scored in the same pass, each by the fit of its
@@ -372,7 +375,11 @@ def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
     extra, folder = injected if injected is not None else (manifest.iloc[:0], None)
     if recordings is not None:
         from .rerun_log import write_rerun_part  # rerun: only where parts are written
-    for path in (out, traces, recordings, folder):
+    if panels is not None:
+        from .figures import FlightPanel, flight_span  # matplotlib: likewise
+        panel = FlightPanel(method)
+        flight_s = dict(zip(manifest["flight"], manifest["flight_s"], strict=True))
+    for path in (out, traces, recordings, panels, folder):
         if path is not None:
             path.mkdir(parents=True, exist_ok=True)
     failures = None if strict else []
@@ -391,6 +398,10 @@ def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
             write_trace(trace, traces / f"{name}.npz", record["provenance"])
             if recordings is not None:
                 write_rerun_part(name, method, trace, recordings / f"{name}.rrd")
+            if panels is not None:
+                panel.draw(trace, record["onset_s"], record["fault_end_s"],
+                           flight_span(record["onset_s"], float(flight_s[name])),
+                           panels / f"{name}.png")
         log.info("%s %s: %s, first alarm %s", method, name, record["outcome"],
                  record["first_alarm_s"])
     for where, rows, prov in [

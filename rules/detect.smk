@@ -11,8 +11,10 @@ rule detect_reference:
     output:
         detections=directory("results/detections/{method}"),
         traces=directory("results/traces/{method}"),
-        # the method's part of each flight's recording, which rerun_logs merges
+        # the method's part of each flight's recording and figure, which rerun_logs
+        # and flight_figures put together
         recordings=directory("results/rerun_parts/{method}"),
+        panels=directory("results/figure_parts/{method}"),
     params:
         # canonical JSON, so that only a changed value (not a reordered key) re-runs it
         spec=lambda w: json.dumps(config["methods"][w.method], sort_keys=True),
@@ -40,6 +42,7 @@ use rule detect_reference as detect with:
         detections=directory("results/detections/{method}"),
         traces=directory("results/traces/{method}"),
         recordings=directory("results/rerun_parts/{method}"),
+        panels=directory("results/figure_parts/{method}"),
         injected=directory("results/injected/detections/{method}"),
     params:
         spec=lambda w: json.dumps(config["methods"][w.method], sort_keys=True),

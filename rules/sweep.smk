@@ -22,13 +22,12 @@ rule sweep:
         "../scripts/sweep.py"
 
 
+# each method's panels, drawn by its detect job, stacked per flight
 rule flight_figures:
-    # the longest jobs start first, and the short ones fill the other cores
-    priority: 2
     input:
         manifest="results/flights.csv",
         detections=expand("results/detections/{method}", method=METHODS),
-        traces=expand("results/traces/{method}", method=METHODS),
+        panels=expand("results/figure_parts/{method}", method=METHODS),
     output:
         report(directory("results/figures/flights"), patterns=["{flight}.png"],
                caption="../report/flight.rst", category="Flights",

@@ -1,8 +1,8 @@
 """Snakemake script: run one configured method over every flight with ground truth and,
 for a method scored on it, over the injected sensor-fault grid, built in memory from
 the cached fault-free flights; each fold is fitted once, on real flights only. Writes
-the detection records, traces, the method's part of each flight's rerun recording, and
-the flights the method had to exclude."""
+the detection records, traces, the method's part of each flight's rerun recording and
+of its figure, and the flights the method had to exclude."""
 
 import json
 from collections import ChainMap
@@ -31,4 +31,5 @@ if "injected" in sm.output.keys():
 write_detections(sm.wildcards.method, json.loads(sm.params.spec), flights, manifest,
                  dict(sm.params.calibration), strict=sm.params.strict, config=sm.config,
                  out=Path(sm.output.detections), traces=Path(sm.output.traces),
-                 recordings=Path(sm.output.recordings), injected=injected)
+                 recordings=Path(sm.output.recordings), panels=Path(sm.output.panels),
+                 injected=injected)
