@@ -26,8 +26,6 @@ import math
 from collections.abc import Sequence
 from fractions import Fraction
 
-from scipy.special import ndtri
-
 __all__ = ["OUTCOMES", "flight_outcome", "mcnemar_exact", "score_records", "summarize",
            "wilson_interval"]
 
@@ -57,6 +55,8 @@ def wilson_interval(successes: int, trials: int, level: float = 0.95) -> tuple[f
     with the lower end 0 at :math:`k = 0` and the upper end 1 at :math:`k = n`."""
     if trials == 0:
         return math.nan, math.nan
+    from scipy.special import ndtri  # here: the detect jobs score outcomes, not intervals
+
     k, n = successes, trials
     p = k / n
     z = float(ndtri(0.5 + 0.5 * level))
