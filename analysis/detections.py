@@ -295,7 +295,7 @@ def read_records(folders) -> list[dict]:
 
 def record_paths(folder) -> list[Path]:
     """The record files of a real flights' detections folder, by name."""
-    return [p for p in sorted(Path(folder).glob("*.json")) if p.name != RUN_RECORD]
+    return sorted(Path(folder).glob("*.json"))
 
 
 def iter_records(folders) -> Iterator[dict]:
@@ -376,7 +376,7 @@ def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
     if recordings is not None:
         from .rerun_log import write_rerun_part  # rerun: only where parts are written
     if panels is not None:
-        from .figures import FlightPanel, flight_span  # matplotlib: likewise
+        from .flight_figures import FlightPanel, flight_span  # matplotlib: likewise
         panel = FlightPanel(method)
         flight_s = dict(zip(manifest["flight"], manifest["flight_s"], strict=True))
     for path in (out, traces, recordings, panels, folder):

@@ -207,6 +207,7 @@ class NestedSelection(Detector):
             raise ValueError(f"nested selection needs training flights of two dates or more; "
                              f"found {len(dates)}")
         digest = [_digest(f.sampled) for f in segments]
+        candidates, groups = self.candidates(), _sharing(made)
         tally = [{"scored": 0, "right": 0, "unfit": []} for _ in made]
         for d in dates:
             held = [f for f, fd in zip(segments, date, strict=True)
@@ -215,12 +216,12 @@ class NestedSelection(Detector):
                 continue
             data = tuple(h for h, fd in zip(digest, date, strict=True) if fd != d)
             training = [f for f, fd in zip(segments, date, strict=True) if fd != d]
-            for group in _sharing(made):
+            for group in groups:
                 fits = {i: self._inner_fit(i, group[0], made, data, training) for i in group}
                 for i in group:
                     if isinstance(fits[i], ValueError):
                         log.info("nested selection: %s cannot be fitted without %s: %s",
-                                 self.candidates()[i], d, fits[i])
+                                 candidates[i], d, fits[i])
                         tally[i]["unfit"].append(d)
                 live = [i for i in group if not isinstance(fits[i], ValueError)]
                 for f in held if live else ():
@@ -233,7 +234,7 @@ class NestedSelection(Detector):
                         tally[i]["scored"] += 1
         inner = [{"values": values, "scored": t["scored"], "right": t["right"],
                   "share": t["right"] / t["scored"] if t["scored"] else math.nan,
-                  "unfit": t["unfit"]} for values, t in zip(self.candidates(), tally, strict=True)]
+                  "unfit": t["unfit"]} for values, t in zip(candidates, tally, strict=True)]
         if not any(c["scored"] for c in inner):
             raise ValueError(f"nested selection of {self.detector!r}: no candidate could be "
                              "fitted and scored on any training date")

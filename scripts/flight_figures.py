@@ -4,7 +4,7 @@ panels each method's detect job drew, stacked under a title and over a time axis
 from pathlib import Path
 
 from alfa_bench.analysis import read_records
-from alfa_bench.analysis.figures import FlightFrame, flight_span
+from alfa_bench.analysis.flight_figures import FlightFrame, flight_span
 from alfa_bench.analysis.logs import log_to
 from alfa_bench.analysis.provenance import run_provenance, stamp
 from alfa_bench.data import read_manifest

@@ -9,7 +9,12 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from alfa_bench.analysis.figures import FlightFrame, FlightPanel, flight_figure, flight_span
+from alfa_bench.analysis.flight_figures import (
+    FlightFrame,
+    FlightPanel,
+    flight_figure,
+    flight_span,
+)
 from alfa_bench.methods import Trace
 
 
