@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import pandas as pd
 
+from alfa_bench.methods import CalibrationError
+
 __all__ = ["GROUPINGS", "HeldOutError", "TooFewGroupsError", "check_held_out", "folds",
            "groups_of"]
 
@@ -19,7 +21,7 @@ __all__ = ["GROUPINGS", "HeldOutError", "TooFewGroupsError", "check_held_out", "
 GROUPINGS = {"date": "date", "flight": "flight"}
 
 
-class TooFewGroupsError(ValueError):
+class TooFewGroupsError(CalibrationError):
     """The flights fall in fewer than two groups: none can be left out."""
 
 

@@ -32,6 +32,7 @@ from alfa_bench.data import (
     reads_actuators,
 )
 from alfa_bench.methods import (
+    CalibrationError,
     Detector,
     Fork,
     Trace,
@@ -42,7 +43,7 @@ from alfa_bench.methods import (
     run_detector,
 )
 
-from .calibration import GROUPINGS, check_held_out, folds, groups_of
+from .calibration import GROUPINGS, TooFewGroupsError, check_held_out, folds, groups_of
 from .isolation import isolate
 from .provenance import provenance, read_table, run_provenance, stamp
 from .scoring import flight_outcome
@@ -64,10 +65,12 @@ INJECTED_RECORDS = "records.jsonl"
 
 def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest: pd.DataFrame,
                calibration: dict, failures: list[dict] | None = None,
-               calibrate_on: pd.DataFrame | None = None) -> Iterator[tuple[dict, Trace]]:
+               calibrate_on: pd.DataFrame | None = None, detector: Detector | None = None
+               ) -> Iterator[tuple[dict, Trace]]:
     """Records and traces (with probes) of ``spec`` (``{"detector": name, "params":
     {...}}``) on every flight of ``manifest`` with ground truth; ``calibration`` is
-    ``{"group_by", "margin_s"}``.
+    ``{"group_by", "margin_s"}``. The detector run is ``detector`` if given (unfitted;
+    ``spec`` then names it in the records), else the registry's ``spec``.
 
     A calibrated method is fitted per fold on the other groups' flights of
     ``calibrate_on`` (default ``manifest``): injected flights are scored by the
@@ -79,7 +82,8 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
     :class:`~alfa_bench.data.AlfaDataError`; with a list, the flight is skipped and a
     :func:`~alfa_bench.data.failure_row` appended, once per flight.
     """
-    detector = make_detector(spec["detector"], spec.get("params"))
+    if detector is None:
+        detector = make_detector(spec["detector"], spec.get("params"))
     train = manifest if calibrate_on is None else calibrate_on
     sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
     sha |= dict(zip(train["flight"], train["sha256"], strict=True))
@@ -95,7 +99,7 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
     scored_by_fold = {g: list(f) for g, f in groups}
     try:
         by_fold = folds(train, calibration["group_by"])
-    except ValueError as e:
+    except TooFewGroupsError as e:
         scorer.uncalibrated([f for names in scored_by_fold.values() for f in names], e)
         return
     group = dict(zip(train["flight"], train[GROUPINGS[calibration["group_by"]]].astype(str),
@@ -112,8 +116,8 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
                 yield out
     if scored_by_fold:
         scorer.uncalibrated([f for names in scored_by_fold.values() for f in names],
-                            ValueError(f"no calibration flights outside group(s) "
-                                       f"{sorted(scored_by_fold)}"))
+                            CalibrationError(f"no calibration flights outside group(s) "
+                                             f"{sorted(scored_by_fold)}"))
 
 
 def _sources(manifest: pd.DataFrame) -> dict[str, tuple[str, list[float]]]:
@@ -173,7 +177,7 @@ class _Scorer:
             self.method, self.spec, self.detector, self.flights[name], self.sha, info,
             forked=self.forks[source]))
 
-    def uncalibrated(self, names: list[str], error: ValueError) -> None:
+    def uncalibrated(self, names: list[str], error: CalibrationError) -> None:
         if self.failures is None:
             raise error
         # not added to ``failed``: the flights are still fault-free data for other folds
@@ -200,8 +204,8 @@ class _Scorer:
         self.forks = {}                # run by the previous fold's fit
         try:
             detector.fit(data)
-        except ValueError as e:
-            self.uncalibrated(scored, ValueError(
+        except CalibrationError as e:
+            self.uncalibrated(scored, CalibrationError(
                 f"fold {fold} ({len(used)} calibration flights): {e}"))
             return None
         log.info("%s: fold %s fitted on %d flights", self.method, fold, len(used))
@@ -213,7 +217,8 @@ class _Scorer:
                 "fitted": detector.fitted()}
 
 
-def calibration_failure(flight: str, method: str, error: ValueError, calibration: dict) -> dict:
+def calibration_failure(flight: str, method: str, error: CalibrationError,
+                        calibration: dict) -> dict:
     """A failures-table row for ``flight``, which ``method`` could not be calibrated to
     score: why, and what to change."""
     advice = ("add fault-free flights (or flights with more time before onset) from other "

@@ -14,24 +14,30 @@ import inspect
 from importlib.metadata import entry_points
 
 from .base import (
+    DEFAULT_RATE_HZ,
+    CalibrationError,
     Detector,
     Fork,
     Labelled,
     NotFittedError,
     PairDetector,
+    StaleStateError,
     Trace,
     fault_free_segments,
+    fit_token,
     forks,
     labelled_segments,
     run_detector,
     skipped_channels,
     training_segments,
 )
+from .extremes import MaximaThresholds
 
-__all__ = ["BUILTIN", "BUILTIN_ENTRIES", "PLUGIN_GROUP", "REGISTRY", "Detector", "Fork",
-           "Labelled", "NotFittedError", "PairDetector", "Trace", "fault_free_segments",
-           "forks", "labelled_segments", "make_detector", "plugins", "run_detector",
-           "skipped_channels", "training_segments"]
+__all__ = ["BUILTIN", "BUILTIN_ENTRIES", "DEFAULT_RATE_HZ", "PLUGIN_GROUP", "REGISTRY",
+           "CalibrationError", "Detector", "Fork", "Labelled", "MaximaThresholds",
+           "NotFittedError", "PairDetector", "StaleStateError", "Trace", "detector_name",
+           "fault_free_segments", "fit_token", "forks", "labelled_segments", "make_detector",
+           "plugins", "run_detector", "skipped_channels", "training_segments"]
 
 #: the entry-point group third-party detectors register under
 PLUGIN_GROUP = "alfa_bench.methods"
@@ -90,6 +96,14 @@ def __getattr__(name: str):
     else:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     return globals()[name]
+
+
+def detector_name(detector: Detector) -> str:
+    """The name a record gives ``detector``'s class: its registry name, else
+    ``"module:Class"`` (a detector written in a script or notebook)."""
+    cls = type(detector)
+    found = [n for n, c in __getattr__("REGISTRY").items() if c is cls]
+    return found[0] if found else f"{cls.__module__}:{cls.__qualname__}"
 
 
 def make_detector(name: str, params: dict | None = None) -> Detector:

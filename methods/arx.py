@@ -12,6 +12,8 @@ from collections import deque
 
 import numpy as np
 
+from .base import CalibrationError
+
 __all__ = ["ArxRegressor", "arx_regressors", "fit_arx"]
 
 
@@ -67,6 +69,6 @@ def fit_arx(segments: list[tuple[np.ndarray, np.ndarray]], na: int, nb: int) -> 
         cross += phi.T @ target                            # Phi' y
         rows += target.size
     if rows < na + nb:
-        raise ValueError(f"{rows} regression rows cannot fit {na + nb} ARX parameters")
+        raise CalibrationError(f"{rows} regression rows cannot fit {na + nb} ARX parameters")
     theta, *_ = np.linalg.lstsq(gram, cross, rcond=None)   # (Phi' Phi) theta = Phi' y
     return theta

@@ -13,10 +13,12 @@ residual, ...) for inspection.
 A run can be *forked*: :meth:`Detector.snapshot` copies the running state after the
 first :math:`k` steps of a flight, and ``run(s, start=k, state=...)`` continues any
 flight that shares those :math:`k` steps from it, as if it had been run from
-:math:`t = 0`. The injected sensor faults are their source flight, unchanged, up to
-the onset, so the steps before it are run once per source and onset
-(:func:`forks`), not once per injected flight. A detector whose :meth:`snapshot` is
-None is run from :math:`t = 0` instead.
+:math:`t = 0`. A state belongs to the fit and hyper-parameters it was taken under
+(:func:`fit_token`): continuing it under others raises :class:`StaleStateError`. The
+injected sensor faults are their source flight, unchanged, up to the onset, so the
+steps before it are run once per source and onset (:func:`forks`), not once per
+injected flight. A detector whose :meth:`snapshot` is None is run from :math:`t = 0`
+instead.
 
 A *calibrated* detector also learns from fault-free data before it runs:
 :meth:`Detector.fit` takes fault-free segments (whole fault-free flights and the
@@ -36,12 +38,22 @@ airspeed from 2018-09-11 on) is never modelled: :func:`run_detector` skips the
 channels that score it, or every channel when a model input is dead
 (:func:`skipped_channels`), and :func:`fault_free_segments` leaves such flights out
 of calibration. Both are logged and recorded.
+
+The least a detector writes is its ``__init__`` (storing its hyper-parameters),
+:meth:`Detector.signals` and :meth:`Detector.update`: it then has one channel, named
+for its class, scoring its first signal, and alarms above its ``threshold``
+hyper-parameter. A calibrated one that budgets false alarms per flight takes its
+thresholds from :class:`~.extremes.MaximaThresholds`. Data too short to fit raises
+:class:`CalibrationError`, the one error the workflow turns into a calibration-failure
+row.
 """
 
 from __future__ import annotations
 
 import copy
+import hashlib
 import inspect
+import json
 import logging
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
@@ -50,26 +62,61 @@ import numpy as np
 
 from alfa_bench.data import Flight, Sampled, not_measured, sample
 
-__all__ = ["Detector", "Fork", "Labelled", "NotFittedError", "PairDetector", "Trace",
-           "fault_free_segments", "forks", "labelled_segments", "run_detector",
-           "skipped_channels", "training_segments"]
+__all__ = ["DEFAULT_RATE_HZ", "CalibrationError", "Detector", "Fork", "Labelled",
+           "NotFittedError", "PairDetector", "StaleStateError", "Trace", "fault_free_segments",
+           "fit_token", "forks", "labelled_segments", "run_detector", "skipped_channels",
+           "training_segments"]
 
 log = logging.getLogger(__name__)
+
+
+#: the grid rate of a detector that does not set its own, Hz: ALFA's attitude rows come
+#: at about 20 Hz
+DEFAULT_RATE_HZ = 20.0
 
 
 class NotFittedError(RuntimeError):
     """A calibrated detector was run before :meth:`Detector.fit`."""
 
 
+class CalibrationError(ValueError):
+    """The data given to :meth:`Detector.fit` is too little or too short to fit: a fold
+    the workflow reports as not calibrated (a failure row), or a nested candidate it
+    leaves unscored. Any other error of a fit is a bug, and stops the run."""
+
+
+class StaleStateError(RuntimeError):
+    """A run was to continue from a state taken under another fit or other
+    hyper-parameters than the detector now has."""
+
+
+def fit_token(detector: Detector) -> str:
+    """What a running state belongs to: a digest of the detector's hyper-parameters and
+    of what :meth:`~Detector.fit` learned (:meth:`~Detector.fitted`)."""
+    text = json.dumps([detector.get_params(), detector.fitted()], sort_keys=True,
+                      default=repr)
+    return hashlib.blake2b(text.encode(), digest_size=16).hexdigest()
+
+
+@dataclass(frozen=True)
+class _Snapshot:
+    """The default :meth:`Detector.snapshot`: the attributes, and the fit they hold."""
+
+    token: str
+    attributes: dict
+
+
 class Detector(ABC):
     """Base class of every registered detector.
 
     Subclasses store their ``__init__`` arguments unchanged under the same names
-    and nothing else, so that :meth:`get_params` can report them.
+    and nothing else, so that :meth:`get_params` can report them. Only
+    :meth:`signals` and :meth:`update` must be written; the other members have
+    defaults for a one-channel detector with a ``threshold`` hyper-parameter.
     """
 
     #: grid rate of the samples :meth:`update` expects, Hz
-    rate_hz: float
+    rate_hz: float = DEFAULT_RATE_HZ
     #: whether :meth:`fit` must see fault-free data before the detector can run
     calibrated: bool = False
     #: whether :meth:`fit` learns from labelled flights (:class:`Labelled` segments)
@@ -83,23 +130,34 @@ class Detector(ABC):
     #: :meth:`rethreshold` sets the thresholds for new values without fitting again
     threshold_params: tuple[str, ...] = ()
 
+    @classmethod
+    def param_names(cls) -> list[str]:
+        """The hyper-parameters' names: those of ``__init__`` (none without one)."""
+        if cls.__init__ is object.__init__:
+            return []
+        return [n for n, p in inspect.signature(cls.__init__).parameters.items()
+                if n != "self" and p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)]
+
     def get_params(self) -> dict:
         """Hyper-parameters by name, as passed to ``__init__``."""
-        names = [p for p in inspect.signature(type(self).__init__).parameters if p != "self"]
-        return {n: getattr(self, n) for n in names}
+        return {n: getattr(self, n) for n in self.param_names()}
 
     @abstractmethod
     def signals(self) -> tuple[str, ...]:
         """Names (see :data:`alfa_bench.data.SIGNALS`) of the input columns."""
 
-    @abstractmethod
     def channels(self) -> tuple[str, ...]:
-        """Names of the score channels."""
+        """Names of the score channels; by default one, named for the class."""
+        return (type(self).__name__.lower(),)
 
-    @abstractmethod
     def channel_outputs(self) -> tuple[str, ...]:
         """Per channel, the measured signal whose behaviour it scores: what the
-        channel isolates when it alarms first."""
+        channel isolates when it alarms first. By default, for one channel, the first
+        of :meth:`signals`."""
+        if len(self.channels()) != 1:
+            raise NotImplementedError(f"{type(self).__name__} has several channels: say "
+                                      "which signal each scores in channel_outputs()")
+        return self.signals()[:1]
 
     def fit(self, segments: list[Sampled] | list[Labelled]) -> Detector:
         """Learn from fault-free ``segments`` (sampled with :meth:`signals` at
@@ -118,14 +176,19 @@ class Detector(ABC):
 
     def rethreshold(self) -> Detector:
         """Set the thresholds again from what :meth:`fit` learned, for the current
-        values of :attr:`threshold_params`; return self. Raise ``ValueError`` where
-        :meth:`fit` would. Only a detector that declares ``threshold_params`` has it."""
+        values of :attr:`threshold_params`; return self. Raise
+        :class:`CalibrationError` where :meth:`fit` would. Only a detector that
+        declares ``threshold_params`` has it."""
         raise NotImplementedError(f"{type(self).__name__} declares no threshold_params")
 
-    @abstractmethod
     def thresholds(self) -> np.ndarray:
         """Per channel, the threshold :math:`\\gamma_c > 0` in score units: channel
-        :math:`c` alarms when :math:`s_c(k) > \\gamma_c`."""
+        :math:`c` alarms when :math:`s_c(k) > \\gamma_c`. By default the
+        ``threshold`` hyper-parameter, for every channel."""
+        if "threshold" not in self.param_names():
+            raise NotImplementedError(f"{type(self).__name__} has no threshold "
+                                      "hyper-parameter: define thresholds()")
+        return np.full(len(self.channels()), float(self.threshold))
 
     def probes(self) -> dict[str, float]:
         """Intermediates of the last :meth:`update` by name (``"<channel>/prediction"``,
@@ -133,10 +196,10 @@ class Detector(ABC):
         :meth:`reset`. None by default."""
         return {}
 
-    @abstractmethod
     def reset(self) -> Detector:
         """Forget everything learned while running (not what :meth:`fit` learned);
-        return self."""
+        return self. A detector without running state need not define it."""
+        return self
 
     def alarms(self, score: np.ndarray) -> np.ndarray:
         """Alarms of scores of shape (..., c): :math:`s_c(k) > \\gamma_c`; a NaN score
@@ -150,12 +213,13 @@ class Detector(ABC):
         cannot continue from a state (a forked run then runs from :math:`t = 0`).
 
         By default a copy of the attributes where :meth:`run` is this class's, which
-        steps :meth:`update`, and None where a subclass overrides :meth:`run`: its
-        batch form must say itself how it continues (and the contract test checks
-        that it does so exactly)."""
+        steps :meth:`update`, with the :func:`fit_token` they were taken under, and
+        None where a subclass overrides :meth:`run`: its batch form must say itself
+        how it continues (and the contract test checks that it does so exactly). An
+        override returns the running state only."""
         if type(self).run is not Detector.run:
             return None
-        return copy.deepcopy(vars(self))
+        return _Snapshot(fit_token(self), copy.deepcopy(vars(self)))
 
     def run(self, s: Sampled, probes: bool = False, start: int = 0,
             state: object | None = None) -> tuple[np.ndarray, dict]:
@@ -166,12 +230,16 @@ class Detector(ABC):
 
         With ``state``, a :meth:`snapshot` taken after running the first ``start``
         steps of ``s``: no reset; the run continues from it over steps ``start:``, and
-        returns theirs only, shape (n - start, c)."""
+        returns theirs only, shape (n - start, c). A state taken under another fit or
+        other hyper-parameters raises :class:`StaleStateError`."""
         if state is None:
             self.reset()
             start = 0
         else:
-            self.__dict__.update(copy.deepcopy(state))
+            if state.token != fit_token(self):
+                raise StaleStateError(f"{type(self).__name__}: the state to continue from "
+                                      "was taken under another fit or other parameters")
+            self.__dict__.update(copy.deepcopy(state.attributes))
         n, c = s.t.size - start, len(self.channels())
         score = np.empty((n, c))
         names = list(self.probes()) if probes else []
@@ -321,6 +389,8 @@ class Fork:
         Empty unless the run kept them.
     kept_probes : bool
         Whether the run kept the probes.
+    token : str
+        The :func:`fit_token` of the detector that ran them.
     """
 
     sampled: Sampled
@@ -328,6 +398,7 @@ class Fork:
     score: np.ndarray
     probes: dict
     kept_probes: bool
+    token: str
 
     def shared_by(self, s: Sampled, probes: bool) -> bool:
         """Whether ``s`` begins with exactly these steps (times, values, freshness), and
@@ -341,7 +412,12 @@ class Fork:
     def continued(self, detector: Detector, s: Sampled, probes: bool
                   ) -> tuple[np.ndarray, dict]:
         """``detector``'s scores and probes over ``s`` (a flight :meth:`shared_by`
-        accepts), these steps' included, running only the steps after them."""
+        accepts), these steps' included, running only the steps after them. A
+        detector fitted or configured otherwise than the one that ran them raises
+        :class:`StaleStateError`."""
+        if fit_token(detector) != self.token:
+            raise StaleStateError(f"{type(detector).__name__}: the fork was run under "
+                                  "another fit or other parameters; fork again")
         more, more_kept = detector.run(s, probes, start=self.sampled.t.size,
                                        state=self.state)
         return (np.vstack([self.score, more]),
@@ -362,7 +438,7 @@ def forks(detector: Detector, flight: Flight, times_s, probes: bool = False
         state = detector.snapshot()
         if state is None:
             return {}
-        out[t_s] = last = Fork(head, state, score, kept, probes)
+        out[t_s] = last = Fork(head, state, score, kept, probes, fit_token(detector))
     return out
 
 
@@ -375,6 +451,8 @@ def run_detector(detector: Detector, flight: Flight, probes: bool = False,
     With ``fork``, a flight that begins with the fork's steps continues from its state
     instead: the same trace, without running those steps again. One that does not (or
     a fork without the probes asked for) runs from a fresh state."""
+    # first: an unfitted calibrated detector stops here, on NotFittedError
+    threshold = np.asarray(detector.thresholds(), dtype=float)
     s = sample(flight, detector.signals(), detector.rate_hz)
     if fork is not None and fork.shared_by(s, probes):
         score, kept = fork.continued(detector, s, probes)
@@ -385,8 +463,7 @@ def run_detector(detector: Detector, flight: Flight, probes: bool = False,
         score[:, [detector.channels().index(ch) for ch in skipped]] = np.nan
         log.info("%s: skipped %s", flight.id, skipped)
     return Trace(t=s.t, score=score, alarm=detector.alarms(score), channels=detector.channels(),
-                 threshold=np.asarray(detector.thresholds(), dtype=float), probes=kept,
-                 skipped=skipped)
+                 threshold=threshold, probes=kept, skipped=skipped)
 
 
 def fault_free_segments(detector: Detector, flights: list[Flight],

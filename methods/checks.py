@@ -7,7 +7,8 @@ Each check takes an unfitted detector, copies it, fits the copy where it is cali
 and raises ``AssertionError`` where the contract fails:
 
 - the constructor stores its hyper-parameters and nothing else; learned state ends
-  in ``_``; a calibrated detector refuses to run unfitted;
+  in ``_``; a calibrated detector refuses to run unfitted; a ``run()`` of its own
+  takes the base class's arguments;
 - fitted values are JSON-ready, outputs have the declared shape, each channel names
   the measured signal it scores, and each has one positive threshold (a channel
   alarms exactly when its score is above it, :meth:`~.base.Detector.alarms`);
@@ -30,6 +31,7 @@ A plugin's own tests run them all with one decorator::
 from __future__ import annotations
 
 import copy
+import inspect
 import json
 import shutil
 import tempfile
@@ -102,7 +104,15 @@ def check_constructor_stores_hyper_parameters_only(detector: Detector) -> None:
     before = set(vars(d))
     _fit(d).reset()
     learned = set(vars(d)) - before
-    assert learned and all(a.endswith("_") for a in learned)
+    assert all(a.endswith("_") for a in learned), sorted(learned)
+    assert learned or not d.calibrated, "a calibrated detector learned nothing"
+
+
+def check_run_takes_the_base_arguments(detector: Detector) -> None:
+    """A ``run()`` override takes ``(s, probes, start, state)``, as the workflow calls
+    it (a snapshot of None means it is never given a state)."""
+    names = list(inspect.signature(type(detector).run).parameters)
+    assert names[:5] == ["self", "s", "probes", "start", "state"], names
 
 
 def check_calibrated_detectors_refuse_to_run_unfitted(detector: Detector) -> None:
@@ -284,6 +294,7 @@ def check_causal(detector: Detector) -> None:
 #: every check, in the order they run
 CHECKS = (
     check_constructor_stores_hyper_parameters_only,
+    check_run_takes_the_base_arguments,
     check_calibrated_detectors_refuse_to_run_unfitted,
     check_fitted_values_are_json_ready,
     check_outputs_have_the_declared_shape,

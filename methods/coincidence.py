@@ -46,8 +46,8 @@ import numpy as np
 
 from alfa_bench.data import Sampled
 
-from .base import Detector
-from .extremes import gumbel_threshold
+from .base import CalibrationError, Detector
+from .extremes import MaximaThresholds
 from .physics import FEATURE_SIGNAL, FEATURES, HISTORY_S, RATE_HZ, SIGNALS_READ, features_of
 from .windows import window_steps
 
@@ -60,7 +60,7 @@ DEFAULT_SIGNATURES = {
 }
 
 
-class Coincidence(Detector):
+class Coincidence(MaximaThresholds, Detector):
     """Channels of coinciding physical signatures (1), with per-flight thresholds (2).
 
     Parameters
@@ -76,13 +76,11 @@ class Coincidence(Detector):
     ----------
     scale_ : dict
         :math:`\\sigma_f` per feature used.
-    maxima_ : dict
-        Per channel, the per-segment maxima of its score over the training segments.
-    gamma_ : ndarray
-        :math:`\\gamma_c` per channel.
+    maxima_, gamma_ : dict
+        Per channel, the per-segment maxima of its score over the training segments
+        and :math:`\\gamma_c` (:class:`~.extremes.MaximaThresholds`).
     """
 
-    calibrated = True
     rate_hz = RATE_HZ
 
     def __init__(self, signatures=DEFAULT_SIGNATURES, quantile=0.99, false_alarm=0.1):
@@ -113,42 +111,29 @@ class Coincidence(Detector):
                 np.min(np.vstack([feats[f] / self.scale_[f] for f in fs]), axis=0)
                 for fs in self._sets()])                              # (1)
 
-    def fit(self, segments: list[Sampled]) -> Coincidence:
-        for attr in ("scale_", "maxima_", "gamma_"):
-            self.__dict__.pop(attr, None)
+    def fit_model(self, segments: list[Sampled]) -> Coincidence:
+        """:math:`\\sigma_f` of (1) for every feature used; the thresholds (2) come
+        from :class:`~.extremes.MaximaThresholds`."""
+        self.__dict__.pop("scale_", None)
         used = sorted({f for fs in self._sets() for f in fs})
         feats = [features_of(s) for s in segments]
         scale = {}
         for f in used:
             values = np.concatenate([v[f][np.isfinite(v[f])] for v in feats])
             if values.size == 0:
-                raise ValueError(f"feature {f!r} is never computed on the fault-free data")
+                raise CalibrationError(f"feature {f!r} is never computed on the fault-free "
+                                       "data")
             scale[f] = float(np.quantile(values, self.quantile))
             if not scale[f] > 0:
-                raise ValueError(f"feature {f!r} has a fault-free {self.quantile} quantile "
-                                 f"of {scale[f]}: nothing to scale by")
+                raise CalibrationError(f"feature {f!r} has a fault-free {self.quantile} "
+                                       f"quantile of {scale[f]}: nothing to scale by")
         self.scale_ = scale
-        maxima = np.array([np.nanmax(np.where(np.isfinite(sc), sc, -np.inf), axis=0)
-                           for sc in (self._scores(v) for v in feats)])
-        maxima = maxima[np.isfinite(maxima).all(axis=1)]
-        if len(maxima) < 3:
-            raise ValueError(f"{len(maxima)} fault-free segments with every channel computed: "
-                             "too few to fit per-flight maxima")
-        names = self.channels()
-        level = 1.0 - self.false_alarm / len(names)
-        self.maxima_ = {c: maxima[:, j].tolist() for j, c in enumerate(names)}
-        self.gamma_ = np.array([gumbel_threshold(maxima[:, j], level)
-                                for j in range(len(names))])                  # (2)
         return self
 
     def fitted(self) -> dict:
         self._check_fitted("gamma_")
         return {"scale": self.scale_, "segment_maxima": self.maxima_,
-                "gamma": self.gamma_.tolist()}
-
-    def thresholds(self) -> np.ndarray:
-        self._check_fitted("gamma_")
-        return self.gamma_
+                "gamma": self.thresholds().tolist()}
 
     def probes(self) -> dict[str, float]:
         last = getattr(self, "last_", {})
@@ -157,7 +142,7 @@ class Coincidence(Detector):
                 for c, fs in zip(self.channels(), self._sets(), strict=True) for f in fs}
 
     def reset(self) -> Coincidence:
-        self._check_fitted("gamma_")
+        self._check_fitted("scale_")
         self.history_ = {"x": [], "fresh": []}
         self.steps_ = 0
         self.last_ = {}

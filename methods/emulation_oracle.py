@@ -126,8 +126,10 @@ class EmulationOracle(Detector):
         score = np.r_[self.since_ / self.rate_hz, zero]
         return score
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
-        """:meth:`update` over ``s``, on whole columns."""
+    def run(self, s: Sampled, probes: bool = False, start: int = 0,
+            state: object | None = None) -> tuple[np.ndarray, dict]:
+        """:meth:`update` over ``s``, on whole columns, from :math:`t = 0` (its
+        :meth:`snapshot` is None, so no run continues from a state)."""
         self.reset()
         flat, zero = _spells(s.x, s.fresh, self.rate_hz)
         score = np.column_stack([flat, zero])

@@ -60,8 +60,10 @@ class EndOfFlight(Detector):
         self.steps_ += 1
         return np.zeros(1)
 
-    def run(self, s: Sampled, probes: bool = False) -> tuple[np.ndarray, dict]:
-        """The whole flight at once: the alarm at its last step."""
+    def run(self, s: Sampled, probes: bool = False, start: int = 0,
+            state: object | None = None) -> tuple[np.ndarray, dict]:
+        """The whole flight at once: the alarm at its last step (from :math:`t = 0`:
+        its :meth:`snapshot` is None, so no run continues from a state)."""
         self.reset()
         score = np.zeros((s.t.size, 1))
         score[-1] = 1.0

@@ -1,8 +1,19 @@
-"""Thresholds from per-flight maxima: a capped Gumbel law.
+r"""Thresholds from per-flight maxima: a capped Gumbel law.
 
 A detector whose false alarms are budgeted per flight, not per sample, reads its
-threshold from the maxima of its score over fault-free segments (:mod:`.residual_bank`,
-:mod:`.learned_fusion`, :mod:`.coincidence`).
+threshold from the maxima of its score over fault-free segments: it writes its
+scoring, and :class:`MaximaThresholds` the rest (:mod:`.residual_bank`,
+:mod:`.learned_fusion`, :mod:`.coincidence`). For each channel :math:`c` of the
+:math:`C`, the maxima :math:`M_{c,j} = \max_t s_c(t)` over the fault-free training
+segments :math:`j` are fitted with a Gumbel law, each capped first so that one extreme
+flight moves it little (:func:`gumbel_threshold`), and
+
+.. math::
+
+    \gamma_c = F^{-1}_{\mathrm{Gumbel}}(1 - lpha / C;\ \hat\mu_c, \hateta_c)
+
+so that a fault-free flight like the training ones alarms on any channel with
+probability about :math:`lpha` (Bonferroni).
 """
 
 from __future__ import annotations
@@ -11,7 +22,12 @@ import math
 
 import numpy as np
 
-__all__ = ["CAP_LEVEL", "gumbel_threshold"]
+from .base import CalibrationError
+
+__all__ = ["CAP_LEVEL", "MIN_SEGMENTS", "MaximaThresholds", "gumbel_threshold"]
+
+#: fewer per-flight maxima than this cannot fit a two-parameter law
+MIN_SEGMENTS = 3
 
 #: per-flight maxima are capped at this quantile of the law their quartiles give
 #: (:func:`gumbel_threshold`): one fault-free flight in a thousand would exceed it
@@ -44,3 +60,75 @@ def gumbel_threshold(maxima: np.ndarray, level: float) -> float:
         _gumbel_unit(0.75) - _gumbel_unit(0.25))
     loc, scale = stats.gumbel_r.fit(np.minimum(maxima, cap))
     return float(stats.gumbel_r.ppf(level, loc, scale))
+
+
+class MaximaThresholds:
+    r"""Per-channel thresholds from per-flight maxima (module docstring), for a
+    :class:`~.base.Detector` with a ``false_alarm`` hyper-parameter :math:`\alpha`:
+    ``class Mine(MaximaThresholds, Detector)``.
+
+    The author writes the scoring (:meth:`~.base.Detector.update`, or a batch
+    :meth:`~.base.Detector.run`) and, where the scores need a model, :meth:`fit_model`;
+    :meth:`fit` fits the model, scores every fault-free segment and thresholds the
+    maxima. A channel's maxima come from the segments on which it scores at all.
+
+    Attributes
+    ----------
+    maxima_ : dict of str to list of float
+        Per channel, :math:`M_{c,j}` over the training segments.
+    gamma_ : dict of str to float
+        Per channel, :math:`\gamma_c`.
+    """
+
+    calibrated = True
+    threshold_params = ("false_alarm",)
+
+    def fit_model(self, segments) -> MaximaThresholds:
+        """Learn what the scores need from fault-free ``segments``; return self.
+        Nothing by default."""
+        return self
+
+    def fit(self, segments) -> MaximaThresholds:
+        """:meth:`fit_model`, then the maxima of the scores of ``segments`` and
+        :meth:`rethreshold`."""
+        for attr in ("maxima_", "gamma_"):
+            self.__dict__.pop(attr, None)
+        self.fit_model(segments)
+        maxima = {c: [] for c in self.channels()}
+        for s in segments:
+            with np.errstate(invalid="ignore"):
+                score, _ = self.run(s)
+            for c, column in zip(maxima, score.T, strict=True):
+                if np.isfinite(column).any():
+                    maxima[c].append(float(np.nanmax(column)))
+        self.maxima_ = maxima
+        return self.rethreshold()
+
+    def rethreshold(self) -> MaximaThresholds:
+        """:math:`\\gamma_c` from the fitted maxima, for ``false_alarm``; return self.
+
+        Raises
+        ------
+        CalibrationError
+            Where a channel has fewer than :data:`MIN_SEGMENTS` maxima."""
+        self.__dict__.pop("gamma_", None)
+        level = 1.0 - self.false_alarm / len(self.maxima_)
+        gamma = {}
+        for name, maxima in self.maxima_.items():
+            if len(maxima) < MIN_SEGMENTS:
+                raise CalibrationError(
+                    f"{type(self).__name__}: channel {name!r} has per-flight maxima from "
+                    f"{len(maxima)} fault-free segments long enough to score; the "
+                    f"extreme-value threshold needs at least {MIN_SEGMENTS}")
+            gamma[name] = max(gumbel_threshold(maxima, level), 1e-9)
+        self.gamma_ = gamma
+        return self
+
+    def thresholds(self) -> np.ndarray:
+        self._check_fitted("gamma_")
+        return np.array([self.gamma_[c] for c in self.channels()])
+
+    def fitted(self) -> dict:
+        """The maxima and the thresholds, per channel."""
+        self._check_fitted("gamma_")
+        return {"segment_maxima": self.maxima_, "gamma": self.gamma_}

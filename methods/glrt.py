@@ -36,6 +36,8 @@ from collections import deque
 import numpy as np
 from scipy.special import chdtri
 
+from .base import CalibrationError
+
 __all__ = ["WindowedGlrt", "chi2_threshold", "empirical_threshold", "glrt_statistic"]
 
 
@@ -100,8 +102,8 @@ def empirical_threshold(g: np.ndarray, false_alarm: float) -> float:
     if not 0.0 < false_alarm < 1.0:
         raise ValueError(f"false-alarm probability must be in (0, 1), got {false_alarm}")
     if g.size * false_alarm < 1.0:
-        raise ValueError(f"{g.size} fault-free samples cannot resolve P_F = {false_alarm}: "
-                         f"need at least {math.ceil(1 / false_alarm)}")
+        raise CalibrationError(f"{g.size} fault-free samples cannot resolve P_F = "
+                               f"{false_alarm}: need at least {math.ceil(1 / false_alarm)}")
     return float(np.quantile(g, 1.0 - false_alarm, method="higher"))
 
 

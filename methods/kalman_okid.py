@@ -39,7 +39,7 @@ import numpy as np
 from alfa_bench.data import Sampled
 
 from . import kernels
-from .base import Detector
+from .base import CalibrationError, Detector
 from .glrt import empirical_threshold
 from .okid import OkidModel, okid
 
@@ -126,7 +126,7 @@ class KalmanOkid(Detector):
                   for i in range(len(self.outputs))]
         for out, m in zip(self.outputs, models, strict=True):
             if not np.allclose(m.A @ np.linalg.solve(m.A, m.L), m.L):
-                raise ValueError(f"OKID model of {out!r} has a singular A: no filter gain")
+                raise CalibrationError(f"OKID model of {out!r} has a singular A: no filter gain")
         self.models_ = models
         runs = [self._innovations(s, self._start_states()) for s in segments]
         e = np.vstack(runs)

@@ -43,14 +43,14 @@ import numpy as np
 
 from alfa_bench.data import Sampled
 
-from .base import Detector
-from .extremes import gumbel_threshold
-from .residual_bank import DEFAULT_MODELS, MIN_SEGMENTS, ResidualBank
+from .base import CalibrationError, Detector
+from .extremes import MaximaThresholds
+from .residual_bank import DEFAULT_MODELS, ResidualBank
 
 __all__ = ["LearnedFusion"]
 
 
-class LearnedFusion(Detector):
+class LearnedFusion(MaximaThresholds, Detector):
     """A Gaussian mixture density (1) over the steps of a
     :class:`~.residual_bank.ResidualBank`.
 
@@ -70,17 +70,15 @@ class LearnedFusion(Detector):
     Attributes
     ----------
     bank_ : ResidualBank
-        Its models (1) fitted on the training segments (its own thresholds infinite:
-        only its steps are used).
+        Its models (1) fitted on the training segments (only its steps are used).
     mixture_ : GaussianMixture
         The mixture of the chosen :math:`K`.
     bic_ : list of float
         BIC per :math:`K` tried.
-    maxima_, gamma_ : list of float, float
-        Per-segment maxima of :math:`s` and the threshold.
+    maxima_, gamma_ : dict
+        Per-segment maxima of :math:`s` and the threshold
+        (:class:`~.extremes.MaximaThresholds`).
     """
-
-    calibrated = True
 
     def __init__(self, models=DEFAULT_MODELS, lags_s=(0.0, 0.5, 1.0, 2.0), window_s=1.0,
                  baseline_s=20.0, max_components=6, thin=5, false_alarm=0.1, random_state=0,
@@ -109,10 +107,6 @@ class LearnedFusion(Detector):
     def channel_outputs(self) -> tuple[str, ...]:
         return (self.models[0]["output"],)
 
-    def thresholds(self) -> np.ndarray:
-        self._check_fitted("gamma_")
-        return np.array([self.gamma_])
-
     def _anomaly(self, d: np.ndarray) -> np.ndarray:
         """:math:`s` of (1) per row of steps ``d``; NaN where a step is not yet defined."""
         s = np.full(d.shape[0], np.nan)
@@ -122,15 +116,17 @@ class LearnedFusion(Detector):
                 s[ok] = -self.mixture_.score_samples(d[ok])                  # (1)
         return s
 
-    def fit(self, segments: list[Sampled]) -> LearnedFusion:
-        self.__dict__.pop("gamma_", None)
+    def fit_model(self, segments: list[Sampled]) -> LearnedFusion:
+        """The bank's models, and the mixture of the chosen :math:`K` on their
+        fault-free steps; the threshold comes from
+        :class:`~.extremes.MaximaThresholds`."""
+        self.__dict__.pop("mixture_", None)
         self.bank_ = self._bank().fit_models(segments)
-        self.bank_.gamma_ = {m["name"]: math.inf for m in self.models}  # its steps only
         steps = [self.bank_.steps(self.bank_.residuals(s)[1]) for s in segments]
         rows = np.vstack([d[np.isfinite(d).all(axis=1)] for d in steps])
         if rows.shape[0] == 0:
-            raise ValueError("learned fusion: no fault-free segment is long enough to "
-                             f"score ({self.window_s + self.baseline_s} s)")
+            raise CalibrationError("learned fusion: no fault-free segment is long enough "
+                                   f"to score ({self.window_s + self.baseline_s} s)")
         rows = rows[::self.thin]
         # imported here: every job imports the registry, only this method needs it
         from sklearn.mixture import GaussianMixture
@@ -139,13 +135,6 @@ class LearnedFusion(Detector):
                 for k in range(1, self.max_components + 1)]
         self.bic_ = [float(m.bic(rows)) for m in fits]
         self.mixture_ = fits[int(np.argmin(self.bic_))]
-        self.maxima_ = [float(np.nanmax(s)) for s in map(self._anomaly, steps)
-                        if np.isfinite(s).any()]
-        if len(self.maxima_) < MIN_SEGMENTS:
-            raise ValueError(f"learned fusion: per-flight maxima from {len(self.maxima_)} "
-                             f"fault-free segments; the extreme-value threshold needs at "
-                             f"least {MIN_SEGMENTS}")
-        self.gamma_ = gumbel_threshold(self.maxima_, 1.0 - self.false_alarm)
         return self
 
     def fitted(self) -> dict:
@@ -154,10 +143,10 @@ class LearnedFusion(Detector):
                          for n, t in self.bank_.theta_.items()},
                 "mixture": {"components": int(self.mixture_.n_components), "bic": self.bic_,
                             "weights": self.mixture_.weights_.tolist()},
-                "segment_maxima": self.maxima_, "gamma": self.gamma_}
+                "segment_maxima": self.maxima_["fused"], "gamma": self.gamma_["fused"]}
 
     def reset(self) -> LearnedFusion:
-        self._check_fitted("gamma_")
+        self._check_fitted("mixture_")
         self.bank_.reset()
         self.last_ = math.nan
         return self

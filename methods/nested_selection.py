@@ -52,7 +52,7 @@ import numpy as np
 from alfa_bench.data import Sampled
 from alfa_bench.data.flight import parse_flight_name
 
-from .base import Detector, Labelled
+from .base import CalibrationError, Detector, Labelled
 
 __all__ = ["NestedSelection", "held_out_right"]
 
@@ -116,8 +116,9 @@ class NestedSelection(Detector):
         The base detector with ``chosen_``, fitted on every training flight.
     inner_fits_ : dict
         Every inner fit made so far, by candidate and data digest (the fitted detector,
-        or the ``ValueError`` it could not be fitted with); kept across :meth:`fit`
-        calls, since the folds repeat half of them (module docstring).
+        or the :class:`~.base.CalibrationError` it could not be fitted with); kept
+        across :meth:`fit` calls, since the folds repeat half of them (module
+        docstring).
     """
 
     calibrated = True
@@ -204,8 +205,8 @@ class NestedSelection(Detector):
         date = [str(parse_flight_name(f.flight)["date"]) for f in segments]
         dates = list(dict.fromkeys(date))
         if len(dates) < 2:
-            raise ValueError(f"nested selection needs training flights of two dates or more; "
-                             f"found {len(dates)}")
+            raise CalibrationError(f"nested selection needs training flights of two dates or "
+                                   f"more; found {len(dates)}")
         digest = [_digest(f.sampled) for f in segments]
         candidates, groups = self.candidates(), _sharing(made)
         tally = [{"scored": 0, "right": 0, "unfit": []} for _ in made]
@@ -219,11 +220,11 @@ class NestedSelection(Detector):
             for group in groups:
                 fits = {i: self._inner_fit(i, group[0], made, data, training) for i in group}
                 for i in group:
-                    if isinstance(fits[i], ValueError):
+                    if isinstance(fits[i], CalibrationError):
                         log.info("nested selection: %s cannot be fitted without %s: %s",
                                  candidates[i], d, fits[i])
                         tally[i]["unfit"].append(d)
-                live = [i for i in group if not isinstance(fits[i], ValueError)]
+                live = [i for i in group if not isinstance(fits[i], CalibrationError)]
                 for f in held if live else ():
                     # one run for the group: its members differ in their thresholds only
                     score, _ = fits[live[0]].run(f.sampled)
@@ -236,8 +237,8 @@ class NestedSelection(Detector):
                   "share": t["right"] / t["scored"] if t["scored"] else math.nan,
                   "unfit": t["unfit"]} for values, t in zip(candidates, tally, strict=True)]
         if not any(c["scored"] for c in inner):
-            raise ValueError(f"nested selection of {self.detector!r}: no candidate could be "
-                             "fitted and scored on any training date")
+            raise CalibrationError(f"nested selection of {self.detector!r}: no candidate could "
+                                   "be fitted and scored on any training date")
         best = max(range(len(inner)), key=lambda i: (np.nan_to_num(inner[i]["share"], nan=-1.0),
                                                     -i))
         self.inner_ = inner
@@ -249,9 +250,9 @@ class NestedSelection(Detector):
         return self
 
     def _inner_fit(self, i: int, first: int, made: list[Detector], data: tuple,
-                   training: list[Labelled]) -> Detector | ValueError:
+                   training: list[Labelled]) -> Detector | CalibrationError:
         """Candidate ``i`` fitted on ``training`` (whose digest is ``data``), or the
-        ``ValueError`` it cannot be fitted with; kept in :attr:`inner_fits_`. A
+        :class:`~.base.CalibrationError` it cannot be fitted with; kept in :attr:`inner_fits_`. A
         candidate that differs from candidate ``first`` of its group in
         :attr:`~.base.Detector.threshold_params` alone is that fit, re-thresholded."""
         kept = self.__dict__.setdefault("inner_fits_", {})
@@ -260,14 +261,14 @@ class NestedSelection(Detector):
             return kept[key]
         shared = kept.get((first, data)) if i != first else None
         try:
-            if shared is None or isinstance(shared, ValueError):
+            if shared is None or isinstance(shared, CalibrationError):
                 kept[key] = copy.deepcopy(made[i].fit(self._free(training)))
             else:
                 det = copy.deepcopy(shared)
                 for name in type(det).threshold_params:
                     setattr(det, name, getattr(made[i], name))
                 kept[key] = det.rethreshold()
-        except ValueError as e:       # too little data without the date: it goes unscored
+        except CalibrationError as e:   # too little data without the date: it goes unscored
             kept[key] = e
         return kept[key]
 

@@ -38,6 +38,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .base import CalibrationError
+
 __all__ = ["OkidModel", "observer_markov", "okid", "system_markov"]
 
 
@@ -79,8 +81,8 @@ def observer_markov(segments: list[tuple[np.ndarray, np.ndarray]],
         cross += phi.T @ target
         rows += target.shape[0]
     if rows < width:
-        raise ValueError(f"{rows} regression rows cannot fit {width} observer Markov "
-                         "parameters; use fewer lags or more data")
+        raise CalibrationError(f"{rows} regression rows cannot fit {width} observer Markov "
+                               "parameters; use fewer lags or more data")
     coef, *_ = np.linalg.lstsq(gram, cross, rcond=None)   # y = coef' [u; v(k-1..k-p)]
     coef = coef.T
     return coef[:, :m], coef[:, m:].reshape(q, lags, m + q).transpose(1, 0, 2)

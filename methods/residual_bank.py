@@ -93,8 +93,8 @@ import numpy as np
 
 from alfa_bench.data import SIGNALS, Sampled
 
-from .base import Detector
-from .extremes import gumbel_threshold
+from .base import CalibrationError, Detector
+from .extremes import MaximaThresholds
 from .windows import step_from_sums, step_means, window_steps
 
 __all__ = ["DEFAULT_MODELS", "ResidualBank", "regressor_signal"]
@@ -118,10 +118,6 @@ DEFAULT_MODELS = (
 _TRANSFORMS = {None: lambda v: v, "sin": np.sin, "tan": np.tan, "sq": np.square}
 _REGRESSOR = re.compile(r"^(?:(sin|tan|sq)\()?([a-z_]+)\)?$")
 
-#: fewer per-flight maxima than this cannot fit a two-parameter law
-MIN_SEGMENTS = 3
-
-
 @cache          # parsed once per name, not at every streaming step
 def regressor_signal(regressor: str) -> tuple[str | None, str]:
     """``"sin(pitch)"`` -> ``("sin", "pitch")``; a bare signal name -> ``(None, name)``."""
@@ -132,7 +128,7 @@ def regressor_signal(regressor: str) -> tuple[str | None, str]:
     return m.group(1), m.group(2)
 
 
-class ResidualBank(Detector):
+class ResidualBank(MaximaThresholds, Detector):
     """Physical residuals (1), each scored for a step (2), with per-flight thresholds (3).
 
     Parameters
@@ -158,9 +154,6 @@ class ResidualBank(Detector):
         sums and counts of (2); the intermediates of the last step.
     """
 
-    calibrated = True
-    threshold_params = ("false_alarm",)
-
     def __init__(self, models=DEFAULT_MODELS, lags_s=(0.0, 0.5, 1.0, 2.0), window_s=1.0,
                  baseline_s=20.0, false_alarm=0.1, rate_hz=20.0):
         self.models = models
@@ -179,10 +172,6 @@ class ResidualBank(Detector):
 
     def channel_outputs(self) -> tuple[str, ...]:
         return tuple(m["output"] for m in self.models)
-
-    def thresholds(self) -> np.ndarray:
-        self._check_fitted("gamma_")
-        return np.array([self.gamma_[m["name"]] for m in self.models])
 
     # -- the models (1) and steps (2), batch ----------------------------------------
 
@@ -247,7 +236,7 @@ class ResidualBank(Detector):
                 levels.append(np.column_stack([y, phi[:, 1:]])[have])
             dy, dphi, levels = np.concatenate(dy), np.vstack(dphi), np.vstack(levels)
             if dy.size <= dphi.shape[1]:
-                raise ValueError(f"residual bank: {dy.size} fault-free steps of "
+                raise CalibrationError(f"residual bank: {dy.size} fault-free steps of "
                                  f"{m['output']} cannot fit the {dphi.shape[1]} parameters "
                                  f"of model {m['name']!r}")
             slope, *_ = np.linalg.lstsq(dphi, dy, rcond=None)     # min sum (dy - dphi' theta)^2
@@ -285,33 +274,10 @@ class ResidualBank(Detector):
 
     # -- calibration -----------------------------------------------------------------
 
-    def fit(self, segments: list[Sampled]) -> ResidualBank:
-        self.__dict__.pop("gamma_", None)
-        self.fit_models(segments)
-        self.maxima_ = {m["name"]: [] for m in self.models}
-        for s in segments:
-            with np.errstate(invalid="ignore"):
-                sc = self.scores(self.steps(self.residuals(s)[1]))
-            for c, m in enumerate(self.models):
-                if np.isfinite(sc[:, c]).any():
-                    self.maxima_[m["name"]].append(float(np.nanmax(sc[:, c])))
-        return self.rethreshold()
-
-    def rethreshold(self) -> ResidualBank:
-        r""":math:`\gamma_c` of (3) from the fitted maxima, for ``false_alarm``."""
-        self.__dict__.pop("gamma_", None)
-        level = 1.0 - self.false_alarm / len(self.models)
-        gamma = {}
-        for name, maxima in self.maxima_.items():
-            if len(maxima) < MIN_SEGMENTS:
-                raise ValueError(
-                    f"residual bank: channel {name!r} has per-flight maxima from "
-                    f"{len(maxima)} fault-free segments long enough to score "
-                    f"({self.window_s + self.baseline_s + max(self.lags_s)} s); the "
-                    f"extreme-value threshold needs at least {MIN_SEGMENTS}")
-            gamma[name] = max(gumbel_threshold(maxima, level), 1e-9)          # (3)
-        self.gamma_ = gamma
-        return self
+    def fit_model(self, segments: list[Sampled]) -> ResidualBank:
+        """The models (1) and scales (2): :meth:`fit_models`; the thresholds (3) come
+        from :class:`~.extremes.MaximaThresholds`."""
+        return self.fit_models(segments)
 
     def fitted(self) -> dict:
         self._check_fitted("gamma_")
@@ -323,7 +289,7 @@ class ResidualBank(Detector):
     # -- streaming -------------------------------------------------------------------
 
     def reset(self) -> ResidualBank:
-        self._check_fitted("gamma_")
+        self._check_fitted("sigma_")
         span = window_steps(self.window_s, self.rate_hz) + window_steps(self.baseline_s,
                                                                        self.rate_hz)
         c = len(self.models)
@@ -337,7 +303,6 @@ class ResidualBank(Detector):
             "names": names, "outputs": [names.index(m["output"]) for m in self.models],
             "lags": self._lags(), "nw": window_steps(self.window_s, self.rate_hz),
             "sigma": np.array([self.sigma_[m["name"]] for m in self.models]),
-            "gamma": self.thresholds(),
         }
         self.last_ = {"prediction": np.full(c, np.nan), "residual": np.full(c, np.nan),
                       "step": np.full(c, np.nan)}
