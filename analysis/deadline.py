@@ -19,11 +19,11 @@ import numpy as np
 import pandas as pd
 
 from alfa_bench.data import subset_flights
+from alfa_bench.outputs.figures import BLOCK_STYLES, colors, plt, save
+from alfa_bench.outputs.render import fmt, markdown
+from alfa_bench.outputs.tables import BLOCKS, block
 
-from .figures import BLOCK_STYLES, colors, plt, save
-from .render import fmt, markdown
 from .scoring import wilson_interval
-from .tables import BLOCKS, block
 
 __all__ = ["deadline_figure", "deadline_markdown", "deadline_table", "false_alarm_time"]
 

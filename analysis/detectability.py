@@ -23,8 +23,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .figures import colors, plt, save
-from .render import fmt, markdown
+from alfa_bench.outputs.figures import colors, plt, save
+from alfa_bench.outputs.render import fmt, markdown
+
 from .scoring import flight_outcome
 
 __all__ = ["detectability_figure", "detectability_markdown", "detectability_table"]

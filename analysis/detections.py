@@ -1,7 +1,7 @@
 """Run a configured method over flights and describe each result as a record.
 
 The record is what ``results/detections/{method}/{flight}.json`` holds. A calibrated
-method is fitted once per fold of :func:`~.calibration.folds`, on the fault-free data
+method is fitted once per fold of :func:`~.held_out.folds`, on the fault-free data
 of the other folds' flights only, and each record names those flights.
 
 A flight the method cannot read (a topic it needs is missing, a gap in its rows)
@@ -42,10 +42,10 @@ from alfa_bench.methods import (
     make_detector,
     run_detector,
 )
+from alfa_bench.outputs.provenance import provenance, read_table, run_provenance, stamp
 
-from .calibration import GROUPINGS, TooFewGroupsError, check_held_out, folds, groups_of
+from .held_out import GROUPINGS, TooFewGroupsError, check_held_out, folds, groups_of
 from .isolation import isolate
-from .provenance import provenance, read_table, run_provenance, stamp
 from .scoring import flight_outcome
 from .traces import write_trace
 
@@ -76,7 +76,7 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
     ``calibrate_on`` (default ``manifest``): injected flights are scored by the
     model of their source's group, fitted on real flights only. A supervised one gets
     those flights whole, with their labels. Before each fit, no segment may come from
-    the group scored (:func:`~.calibration.check_held_out`, which stops the run).
+    the group scored (:func:`~.held_out.check_held_out`, which stops the run).
 
     With ``failures`` None, a flight that cannot be read raises its
     :class:`~alfa_bench.data.AlfaDataError`; with a list, the flight is skipped and a
@@ -87,11 +87,11 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
     train = manifest if calibrate_on is None else calibrate_on
     sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
     sha |= dict(zip(train["flight"], train["sha256"], strict=True))
-    scorer = _Scorer(method, spec, detector, flights, sha, calibration, failures,
+    runner = _FoldRunner(method, spec, detector, flights, sha, calibration, failures,
                      _sources(manifest))
     if not detector.calibrated:
         for name in manifest.loc[manifest["ground_truth"], "flight"]:
-            if (out := scorer.record(name)) is not None:
+            if (out := runner.record(name)) is not None:
                 yield out
         return
     scored = manifest.loc[manifest["ground_truth"]]
@@ -100,7 +100,7 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
     try:
         by_fold = folds(train, calibration["group_by"])
     except TooFewGroupsError as e:
-        scorer.uncalibrated([f for names in scored_by_fold.values() for f in names], e)
+        runner.uncalibrated([f for names in scored_by_fold.values() for f in names], e)
         return
     group = dict(zip(train["flight"], train[GROUPINGS[calibration["group_by"]]].astype(str),
                      strict=True))
@@ -108,14 +108,14 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
         scored = scored_by_fold.pop(fold, [])
         if not scored:
             continue
-        info = scorer.fit(fold, training, scored, group)
+        info = runner.fit(fold, training, scored, group)
         if info is None:
             continue
         for name in scored:
-            if (out := scorer.record(name, info)) is not None:
+            if (out := runner.record(name, info)) is not None:
                 yield out
     if scored_by_fold:
-        scorer.uncalibrated([f for names in scored_by_fold.values() for f in names],
+        runner.uncalibrated([f for names in scored_by_fold.values() for f in names],
                             CalibrationError(f"no calibration flights outside group(s) "
                                              f"{sorted(scored_by_fold)}"))
 
@@ -131,8 +131,9 @@ def _sources(manifest: pd.DataFrame) -> dict[str, tuple[str, list[float]]]:
                                                strict=True)}
 
 
-class _Scorer:
-    """One method's run over flights: each flight's record, made once; a flight's bad
+class _FoldRunner:
+    """One method's run over flights, fold by fold: it fits the detector per fold,
+    forks it and runs it; each flight's record is made once; a flight's bad
     data turned into a failure row (or raised, with ``failures`` None), after which the
     flight is neither scored nor calibrates; and a fold it cannot calibrate turned into
     failure rows for the flights that fold scores.
@@ -379,9 +380,14 @@ def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
     """
     extra, folder = injected if injected is not None else (manifest.iloc[:0], None)
     if recordings is not None:
-        from .rerun_log import write_rerun_part  # rerun: only where parts are written
+        from alfa_bench.outputs.rerun_log import (
+            write_rerun_part,  # rerun: only where parts are written
+        )
     if panels is not None:
-        from .flight_figures import FlightPanel, flight_span  # matplotlib: likewise
+        from alfa_bench.outputs.flight_figures import (  # matplotlib: likewise
+            FlightPanel,
+            flight_span,
+        )
         panel = FlightPanel(method)
         flight_s = dict(zip(manifest["flight"], manifest["flight_s"], strict=True))
     for path in (out, traces, recordings, panels, folder):

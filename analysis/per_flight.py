@@ -34,11 +34,11 @@ import pandas as pd
 
 from alfa_bench.data import subset_flights
 from alfa_bench.methods import Trace
+from alfa_bench.outputs.render import fmt, markdown
+from alfa_bench.outputs.tables import BLOCK_MARKS, BLOCKS, block
 
 from .isolation import named_class, names_class
-from .render import fmt, markdown
 from .scoring import flight_outcome
-from .tables import BLOCK_MARKS, BLOCKS, block
 
 __all__ = ["margins", "per_flight_markdown", "per_flight_table", "verdict"]
 

@@ -31,7 +31,7 @@ flights instead: its :meth:`~Detector.fit` receives :class:`Labelled` segments
 (:func:`labelled_segments`), whole flights of the other groups with their onset and
 fault class, so it may learn what a fault looks like. It says so: the tables'
 calibration column reads ``supervised``. Neither kind ever sees a flight of the group
-it scores (:func:`alfa_bench.analysis.calibration.check_held_out`).
+it scores (:func:`alfa_bench.analysis.held_out.check_held_out`).
 
 A signal that is not measured on a flight (constant over all of it, like measured
 airspeed from 2018-09-11 on) is never modelled: :func:`run_detector` skips the

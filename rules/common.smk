@@ -5,8 +5,8 @@ from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
 
-from alfa_bench.analysis.dependencies import module_sources
-from alfa_bench.analysis.provenance import RUN_FILE
+from alfa_bench.workflow.dependencies import module_sources
+from alfa_bench.outputs.provenance import RUN_FILE
 from alfa_bench.data import SIGNALS, resolve_alfa_dir
 from alfa_bench.methods import REGISTRY, make_detector
 

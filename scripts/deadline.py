@@ -5,10 +5,10 @@ from pathlib import Path
 
 from alfa_bench.analysis import read_records
 from alfa_bench.analysis.deadline import deadline_figure, deadline_markdown, deadline_table
-from alfa_bench.analysis.figures import detection_time_figure
-from alfa_bench.analysis.logs import log_to
-from alfa_bench.analysis.provenance import run_provenance, stamp
 from alfa_bench.data import read_manifest, subset_flights
+from alfa_bench.outputs.figures import detection_time_figure
+from alfa_bench.outputs.provenance import run_provenance, stamp
+from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])

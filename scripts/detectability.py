@@ -9,9 +9,9 @@ from alfa_bench.analysis.detectability import (
     detectability_table,
 )
 from alfa_bench.analysis.detections import iter_records
-from alfa_bench.analysis.logs import log_to
-from alfa_bench.analysis.provenance import run_provenance, stamp
 from alfa_bench.data import read_manifest
+from alfa_bench.outputs.provenance import run_provenance, stamp
+from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])

@@ -3,8 +3,8 @@
 import logging
 import sys
 
-from alfa_bench.analysis.logs import log_to
 from alfa_bench.data import DownloadError, fetch_alfa
+from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])

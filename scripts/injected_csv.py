@@ -3,9 +3,9 @@
 import logging
 from pathlib import Path
 
-from alfa_bench.analysis.logs import log_to
 from alfa_bench.data import read_manifest
 from alfa_bench.data.inject import inject_grid
+from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])

@@ -4,8 +4,8 @@ write each flight read to the parsed-flight cache."""
 
 import pandas as pd
 
-from alfa_bench.analysis.logs import log_to
 from alfa_bench.data import FAILURE_COLUMNS, build_manifest, scan_flights
+from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])

@@ -1,8 +1,8 @@
 """Snakemake script: the run's provenance, with the SHA-256 of every output."""
 
-from alfa_bench.analysis.logs import log_to
-from alfa_bench.analysis.provenance import run_provenance, write_run_file
 from alfa_bench.data import read_manifest
+from alfa_bench.outputs.provenance import run_provenance, write_run_file
+from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])

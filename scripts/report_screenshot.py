@@ -3,8 +3,8 @@ browser."""
 
 import logging
 
-from alfa_bench.analysis.logs import log_to
-from alfa_bench.analysis.report_page import open_report
+from alfa_bench.workflow.logs import log_to
+from alfa_bench.workflow.report_page import open_report
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])

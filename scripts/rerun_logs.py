@@ -5,12 +5,12 @@ import json
 import logging
 from pathlib import Path
 
-from alfa_bench.analysis.logs import log_to
-from alfa_bench.analysis.provenance import run_provenance
-from alfa_bench.analysis.rerun_log import merge_rerun_log
 from alfa_bench.data import read_cached, read_manifest
 from alfa_bench.data.cache import cache_path
 from alfa_bench.methods import make_detector
+from alfa_bench.outputs.provenance import run_provenance
+from alfa_bench.outputs.rerun_log import merge_rerun_log
+from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])

@@ -2,12 +2,12 @@
 table and a figure."""
 
 from alfa_bench.analysis import read_records
-from alfa_bench.analysis.figures import sweep_figure
-from alfa_bench.analysis.logs import log_to
-from alfa_bench.analysis.provenance import run_provenance, stamp
 from alfa_bench.analysis.sweep import sweep_table
 from alfa_bench.analysis.traces import read_traces
 from alfa_bench.data import read_manifest
+from alfa_bench.outputs.figures import sweep_figure
+from alfa_bench.outputs.provenance import run_provenance, stamp
+from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])

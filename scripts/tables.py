@@ -20,11 +20,11 @@ from alfa_bench.analysis import (
     summary_table,
 )
 from alfa_bench.analysis.leakage import audit_note
-from alfa_bench.analysis.logs import log_to
-from alfa_bench.analysis.provenance import read_table, run_provenance, stamp
-from alfa_bench.analysis.render import markdown_html
-from alfa_bench.analysis.tables import unscored_notes
 from alfa_bench.data import read_manifest
+from alfa_bench.outputs.provenance import read_table, run_provenance, stamp
+from alfa_bench.outputs.render import markdown_html
+from alfa_bench.outputs.tables import unscored_notes
+from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])

@@ -3,8 +3,8 @@
 import logging
 from pathlib import Path
 
-from alfa_bench.analysis.logs import log_to
-from alfa_bench.analysis.viewer import screenshot, serve_recording
+from alfa_bench.workflow.logs import log_to
+from alfa_bench.workflow.viewer import screenshot, serve_recording
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])

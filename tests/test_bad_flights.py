@@ -11,13 +11,13 @@ from broken import IMU, ROLL, edit, set_cell
 from recordings import content
 
 from alfa_bench.analysis import detect_all
-from alfa_bench.analysis.rerun_log import write_rerun_log
 from alfa_bench.data import load_flight, scan_flights
 from alfa_bench.data.inject import InjectedGrid
 from alfa_bench.data.manifest import manifest_of, manifest_row
 from alfa_bench.data.synthetic import write_flight
 from alfa_bench.methods import make_detector, run_detector
 from alfa_bench.methods.extremes import CAP_LEVEL, gumbel_threshold
+from alfa_bench.outputs.rerun_log import write_rerun_log
 
 FREE = "carbonZ_2018-07-18-16-37-39_1_no_failure"
 ENGINE = "carbonZ_2018-07-18-15-53-31_1_engine_failure"

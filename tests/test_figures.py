@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from alfa_bench.analysis.flight_figures import (
+from alfa_bench.methods import Trace
+from alfa_bench.outputs.flight_figures import (
     FlightFrame,
     FlightPanel,
     flight_figure,
     flight_span,
 )
-from alfa_bench.methods import Trace
 
 
 def trace(t_end: float, alarm_at: float | None, dt: float = 0.1) -> Trace:

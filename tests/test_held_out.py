@@ -10,7 +10,7 @@ import yaml
 
 import alfa_bench.analysis.detections as detections
 from alfa_bench.analysis import detect_all, folds
-from alfa_bench.analysis.calibration import HeldOutError
+from alfa_bench.analysis.held_out import HeldOutError
 from alfa_bench.methods import REGISTRY, Detector, Labelled, make_detector
 
 CONFIG = yaml.safe_load((Path(__file__).parent.parent / "config/config.yaml").read_text())

@@ -12,8 +12,8 @@ from alfa_bench.analysis.scoring import (
     summarize,
     wilson_interval,
 )
-from alfa_bench.analysis.tables import block, comparison_table
 from alfa_bench.data import read_manifest
+from alfa_bench.outputs.tables import block, comparison_table
 
 
 def test_a_first_alarm_after_the_deadline_is_a_miss():
@@ -111,8 +111,8 @@ def test_a_subset_without_flights_has_no_rows_and_a_fully_excluded_run_is_named(
     an error; a run every flight of which was excluded is listed as not scored."""
     import pandas as pd
 
-    from alfa_bench.analysis.tables import unscored_notes
     from alfa_bench.data import build_manifest
+    from alfa_bench.outputs.tables import unscored_notes
     manifest = build_manifest(corpus)
     manifest = manifest[~manifest["emergency_trajectory"]]
     flights = manifest.loc[manifest["ground_truth"]]

@@ -6,8 +6,8 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from alfa_bench.analysis.paper import latex_keys, latex_macros, paper_numbers, render_markdown
-from alfa_bench.analysis.tables import comparison_latex
+from alfa_bench.outputs.paper import latex_keys, latex_macros, paper_numbers, render_markdown
+from alfa_bench.outputs.tables import comparison_latex
 
 REPO = Path(__file__).resolve().parent.parent
 TEX = (REPO / "paper/paper.tex").read_text()
@@ -125,8 +125,8 @@ def test_every_quoted_key_is_one_the_numbers_define():
     sweeps = pd.DataFrame([{"method": m, "subset": s, "fp": 0, "recall": 0.0}
                            for m in config["methods"] for s in config["subsets"]])
     # every catalogue signal and fault class, as the leakage audit writes them
-    from alfa_bench.analysis.tables import FAULT_ORDER
     from alfa_bench.data import SIGNALS
+    from alfa_bench.outputs.tables import FAULT_ORDER
     leak = pd.DataFrame([{**leakage().iloc[0].to_dict(), "signal": sig, "fault_class": c}
                          for sig in SIGNALS for c in FAULT_ORDER if c != "none"])
     assert latex_keys(TEX) <= set(paper_numbers(pd.DataFrame(rows), sweeps, leak))
@@ -144,7 +144,7 @@ def test_latex_tables_escape_and_label():
 
 
 def test_sensor_fault_numbers_come_from_the_grid_and_the_isolation_tables():
-    from alfa_bench.analysis.paper import sensor_numbers
+    from alfa_bench.outputs.paper import sensor_numbers
     grid = pd.DataFrame({"method": ["a", "a", "b"], "flights": [4, 4, 8],
                          "detected": [4, 2, 2], "chance_rate": [0.5, 0.0, 0.0]})
     iso = pd.DataFrame({"method": ["a", "a", "b", "b"], "flight": ["x", "y", "x", "y"],

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from alfa_bench.analysis.png import adler32_combine, stack, write_png
+from alfa_bench.outputs.png import adler32_combine, stack, write_png
 
 
 def image(h: int, w: int, seed: int) -> np.ndarray:

@@ -10,16 +10,16 @@ import rerun.blueprint as rrb
 import rerun.chunk as rc
 from recordings import content
 
-from alfa_bench.analysis.provenance import read_provenance
-from alfa_bench.analysis.rerun_log import (
+from alfa_bench.data import load_flight, series
+from alfa_bench.methods import make_detector, run_detector
+from alfa_bench.outputs.provenance import read_provenance
+from alfa_bench.outputs.rerun_log import (
     TIMELINE,
     blueprint,
     merge_rerun_log,
     write_rerun_log,
     write_rerun_part,
 )
-from alfa_bench.data import load_flight, series
-from alfa_bench.methods import make_detector, run_detector
 
 SIGNALS = ["roll_cmd", "roll", "roll_error", "roll_rate", "servo_aileron_left"]
 

@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from alfa_bench.analysis.provenance import read_provenance, run_id, stamp, write_run_file
+from alfa_bench.outputs.provenance import read_provenance, run_id, stamp, write_run_file
 
 
 def test_tables_are_read_against_the_checksum_of_their_run(tmp_path):

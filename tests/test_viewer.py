@@ -7,10 +7,10 @@ import urllib.request
 import numpy as np
 import pytest
 
-from alfa_bench.analysis.rerun_log import write_rerun_log
-from alfa_bench.analysis.viewer import check_screenshot, chromium, screenshot, serve_recording
 from alfa_bench.data import load_flight
 from alfa_bench.methods import make_detector, run_detector
+from alfa_bench.outputs.rerun_log import write_rerun_log
+from alfa_bench.workflow.viewer import check_screenshot, chromium, screenshot, serve_recording
 
 pytest.importorskip("playwright", reason="Playwright is not installed: the viewer check "
                                          "did not run")

@@ -22,10 +22,10 @@ from alfa_bench.analysis.detections import (
     iter_records,
     read_run_record,
 )
-from alfa_bench.analysis.provenance import RUN_FILE, read_provenance, read_table
 from alfa_bench.analysis.traces import read_trace
 from alfa_bench.data.synthetic import write_flight
 from alfa_bench.methods import REGISTRY, make_detector
+from alfa_bench.outputs.provenance import RUN_FILE, read_provenance, read_table
 
 # Snakemake or pip in a subprocess, minutes in all: `pytest -m "not workflow"` skips them
 pytestmark = pytest.mark.workflow
@@ -215,8 +215,8 @@ def test_the_html_report_holds_the_figures_and_tables(runs, corpus):
     for name in ("sweep.png", "detection_time.png", "comparison.csv", "paper.md"):
         assert name in html, name
     # in a real browser: it opens on the overview, the headline table and the figures show
-    from alfa_bench.analysis.report_page import open_report
-    from alfa_bench.analysis.viewer import chromium
+    from alfa_bench.workflow.report_page import open_report
+    from alfa_bench.workflow.viewer import chromium
     if chromium() is None:
         pytest.skip("no Chromium (apt-get install chromium): the report was not opened")
     view = open_report(work / "report.html", work / "report.png", "Comparison",
@@ -503,7 +503,7 @@ def _has_value(key: str, tables: dict) -> bool:
 def test_the_paper_has_no_gap_where_the_tables_hold_the_number(runs):
     """Every "n/a" of the rendered paper stands where the run's tables have no such
     number (section 5's per-class counts once read n/a over a full by_fault table)."""
-    from alfa_bench.analysis.paper import paper_numbers
+    from alfa_bench.outputs.paper import paper_numbers
     out = runs[0] / "results/tables"
     tables = {n: read_table(out / f"{n}.csv") for n in
               ("comparison", "by_fault", "per_flight", "leakage", "sweep")}

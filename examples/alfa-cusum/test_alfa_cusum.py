@@ -5,6 +5,6 @@ from alfa_cusum import Cusum
 from alfa_bench.methods.checks import parametrize_with_checks
 
 
-@parametrize_with_checks([Cusum(), Cusum(signal="pitch_error", margin=1.5)])
+@parametrize_with_checks([Cusum(), Cusum(signal="pitch_error", false_alarm=0.2)])
 def test_cusum(detector, check):
     check(detector)

@@ -50,9 +50,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from alfa_bench.analysis.reference import ICRA2019_SUMMARY
 from alfa_bench.data import SIGNALS
 
-from .reference import ICRA2019_SUMMARY
 from .render import latex_escape
 from .tables import FAULT_ORDER, SIGNIFICANCE
 

@@ -19,11 +19,11 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.ticker import FixedLocator, NullLocator
 
+from alfa_bench.analysis.sweep import ratio
 from alfa_bench.methods import Trace
 
 from .figures import DPI
 from .png import stack, write_png
-from .sweep import ratio
 
 __all__ = ["FLIGHT_WINDOW_S", "FlightFrame", "FlightPanel", "flight_figure", "flight_span"]
 

@@ -10,7 +10,7 @@ and its console does not say when a recording has arrived:
 - the recording's plots draw coloured lines in the signal and overview rows, where
   the welcome screen is grey text on white;
 - the time panel shows the fault's span selected (rerun's selection blue), which
-  is where the blueprint opens (:func:`alfa_bench.analysis.rerun_log.blueprint`).
+  is where the blueprint opens (:func:`alfa_bench.outputs.rerun_log.blueprint`).
 """
 
 from __future__ import annotations

@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .calibration import TooFewGroupsError, folds
+from alfa_bench.analysis.held_out import TooFewGroupsError, folds
 
 __all__ = ["PACKAGES", "RUN_FILE", "code_version", "file_sha256", "package_versions", "provenance",
            "read_provenance", "read_table", "run_id", "run_provenance", "stamp", "write_run_file"]

@@ -31,12 +31,12 @@ import math
 
 import pandas as pd
 
+from alfa_bench.analysis.isolation import names_class
+from alfa_bench.analysis.reference import ICRA2019_BY_FAULT, ICRA2019_NAME, ICRA2019_SUMMARY
+from alfa_bench.analysis.scoring import mcnemar_exact, score_records
 from alfa_bench.data import FAILURE_COLUMNS, FAULT_CLASSES, subset_flights
 
-from .isolation import names_class
-from .reference import ICRA2019_BY_FAULT, ICRA2019_NAME, ICRA2019_SUMMARY
 from .render import Section, fmt, latex_tables, markdown
-from .scoring import mcnemar_exact, score_records
 
 __all__ = ["BLOCKS", "BLOCK_MARKS", "FAULT_ORDER", "SIGNIFICANCE", "block", "by_fault_latex",
            "by_fault_markdown", "by_fault_table", "comparison_latex", "comparison_markdown",

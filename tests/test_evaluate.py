@@ -1,0 +1,143 @@
+"""The Python route (analysis/evaluation.py): a corpus parsed once, a detector written in
+three members scored by evaluate() and ranked by compare(), and the workflow's own
+records from evaluate() of a configured run on the real flights."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from broken import ROLL, edit, set_cell
+
+import alfa_bench as ab
+from alfa_bench.analysis import evaluation
+from alfa_bench.analysis.per_flight import per_flight_table
+from alfa_bench.methods import DEFAULT_RATE_HZ, Detector
+from alfa_bench.methods.checks import parametrize_with_checks
+
+REPO = Path(__file__).resolve().parent.parent
+
+
+class RollError(Detector):
+    """The whole of a stateless detector: alarm when the roll is off its command."""
+
+    def __init__(self, threshold=30.0):
+        self.threshold = threshold
+
+    def signals(self):
+        return ("roll_error",)
+
+    def update(self, x, fresh):
+        return np.abs(x[:1])
+
+
+@parametrize_with_checks([RollError()])
+def test_three_members_meet_the_contract(detector, check):
+    check(detector)
+
+
+def test_the_base_class_supplies_the_rest():
+    d = RollError(threshold=12.0)
+    assert d.get_params() == {"threshold": 12.0}
+    assert d.channels() == ("rollerror",) and d.channel_outputs() == ("roll_error",)
+    np.testing.assert_array_equal(d.thresholds(), [12.0])
+    assert d.rate_hz == DEFAULT_RATE_HZ and d.reset() is d
+
+
+@pytest.fixture(scope="module")
+def local(corpus, tmp_path_factory):
+    """The synthetic corpus loaded through the Python route, with the repository's
+    config (its small injected grid for the tests)."""
+    config = ab.load_config(REPO / "config/config.yaml")
+    config["injection"] = {"sensors": ["roll"], "faults": [{"kind": "drift",
+                                                             "magnitude": 0.5}],
+                           "onsets": [0.5]}
+    return ab.load_corpus(corpus.parent, config=config,
+                          cache=tmp_path_factory.mktemp("cache"))
+
+
+def test_a_corpus_is_parsed_once_and_again_when_a_flight_changes(corpus, tmp_path,
+                                                                   monkeypatch):
+    import shutil
+
+    processed = shutil.copytree(corpus, tmp_path / "alfa" / "processed")
+    config = ab.load_config(REPO / "config/config.yaml")
+    first = ab.load_corpus(processed.parent, config=config, cache=tmp_path / "cache")
+    assert len(first.manifest) == len(list(processed.iterdir())) and first.failures.empty
+
+    def parse(*args, **kwargs):
+        raise AssertionError("parsed again")
+
+    with monkeypatch.context() as m:
+        m.setattr(evaluation, "scan_flights", parse)
+        again = ab.load_corpus(processed.parent, config=config, cache=tmp_path / "cache")
+    pd.testing.assert_frame_equal(again.manifest, first.manifest)
+    name = first.manifest["flight"].iloc[0]
+    # one measured roll a little off: the same flight, other files
+    edit(ROLL, lambda lines: [*lines[:-1], set_cell(lines[-1], -1, "1.25")])(processed / name)
+    changed = ab.load_corpus(processed.parent, config=config, cache=tmp_path / "cache")
+    sha = dict(zip(changed.manifest["flight"], changed.manifest["sha256"], strict=True))
+    assert sha[name] != dict(zip(first.manifest["flight"], first.manifest["sha256"],
+                                 strict=True))[name]
+
+
+def test_evaluate_scores_a_three_member_detector_and_compare_ranks_it(local):
+    result = ab.evaluate(RollError(), local)
+    flights = local.manifest.loc[local.manifest["ground_truth"], "flight"]
+    assert sorted(r["flight"] for r in result.records) == sorted(flights)
+    assert result.records[0]["detector"] == f"{__name__}:RollError"
+    # the workflow's tables, from the same functions over the same records
+    assert list(result.summary["subset"]) == evaluation._subsets(local.config)
+    assert list(result.per_flight.columns) == list(per_flight_table(
+        result.records, {("rollerror", f): t for f, t in result.traces.items()},
+        local.manifest, 5.0).columns)
+    other = ab.evaluate("residual_bank", local)
+    table = ab.compare(result, other, published=None)
+    for subset, rows in table.groupby("subset"):
+        assert set(rows["method"]) == {"rollerror", "residual_bank"}, subset
+        ranked = rows.dropna(subset=["rank"]).sort_values("rank")
+        assert list(ranked["rank"]) == list(range(1, len(ranked) + 1))
+    with pytest.raises(ValueError, match="share a name"):
+        ab.compare(result, result, published=None)
+
+
+def test_a_configured_run_is_scored_with_its_parameters_and_its_grid(local):
+    result = ab.evaluate("residual_bank_energy", local, injected=True, deadline_s=2.0)
+    assert result.method == "residual_bank_energy"
+    assert {r["parameters"]["models"][-1]["name"] for r in result.records} == {"climb"}
+    assert set(result.summary["deadline_s"]) == {2.0}
+    assert result.injected and {r["fault_class"] for r in result.injected} == {"sensor"}
+    assert all(r["calibration"]["fold"] for r in result.injected)
+
+
+def test_a_recording_opens_on_the_method(local, tmp_path):
+    result = ab.evaluate(RollError(), local)
+    name = result.records[0]["flight"]
+    path = result.recording(name, tmp_path / f"{name}.rrd")
+    assert path.stat().st_size > 0
+
+
+def _without_provenance(record: dict) -> dict:
+    return {k: v for k, v in record.items() if k != "provenance"}
+
+
+def test_evaluate_gives_the_workflows_records_on_the_real_flights(real_processed, tmp_path):
+    """The workflow's records of residual_bank, where this checkout's `snakemake all`
+    has written them (.ci/run runs this test again after it)."""
+    folder = REPO / "results/detections/residual_bank"
+    manifest = REPO / "results/flights.csv"
+    if not folder.is_dir() or not manifest.is_file():
+        pytest.skip("no results/ of a workflow run in this checkout")
+    corpus = ab.load_corpus(real_processed.parent, cache=tmp_path / "cache")
+    published = pd.read_csv(manifest)
+    if set(published["sha256"]) != set(corpus.manifest["sha256"]):
+        pytest.skip("results/ was made from another copy of ALFA")
+    result = ab.evaluate("residual_bank", corpus)
+    workflow = {p.stem: json.loads(p.read_text()) for p in folder.glob("*.json")}
+    assert sorted(workflow) == sorted(r["flight"] for r in result.records)
+    for r in result.records:
+        mine, theirs = _without_provenance(r), _without_provenance(workflow[r["flight"]])
+        assert mine["outcome"] == theirs["outcome"], r["flight"]
+        assert mine["first_alarm_s"] == theirs["first_alarm_s"], r["flight"]
+        assert json.loads(json.dumps(mine, sort_keys=True, default=list)) == theirs
