@@ -15,34 +15,16 @@ figures, recordings, provenance, the paper) and :mod:`alfa_bench.workflow` (what
 the Snakemake rules and scripts use).
 """
 
-import importlib
+from alfa_bench.lazy import lazy_names
 
 # each name's module, imported when the name is first used: a workflow job that imports
 # one module of the package pays for no other
 _MODULES = {
-    "Corpus": "alfa_bench.analysis.evaluation",
-    "Result": "alfa_bench.analysis.evaluation",
-    "compare": "alfa_bench.analysis.evaluation",
-    "evaluate": "alfa_bench.analysis.evaluation",
-    "load_config": "alfa_bench.analysis.evaluation",
-    "load_corpus": "alfa_bench.analysis.evaluation",
-    "CalibrationError": "alfa_bench.methods",
-    "Detector": "alfa_bench.methods",
-    "MaximaThresholds": "alfa_bench.methods",
-    "NotFittedError": "alfa_bench.methods",
-    "make_detector": "alfa_bench.methods",
+    **dict.fromkeys(["Corpus", "Result", "compare", "evaluate", "load_config", "load_corpus"],
+                    "alfa_bench.analysis.evaluation"),
+    **dict.fromkeys(["CalibrationError", "Detector", "MaximaThresholds", "NotFittedError",
+                     "make_detector"], "alfa_bench.methods"),
 }
 
 __all__ = sorted(_MODULES)
-
-
-def __getattr__(name: str):
-    if name not in _MODULES:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(_MODULES[name]), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return list(__all__)
+__getattr__, __dir__ = lazy_names(__name__, _MODULES)
