@@ -45,6 +45,30 @@ def test_the_base_class_supplies_the_rest():
     assert d.rate_hz == DEFAULT_RATE_HZ and d.reset() is d
 
 
+class Sideslip(Detector):
+    """No hyper-parameters, so no __init__: its threshold is its own."""
+
+    def signals(self):
+        return ("accel_y",)
+
+    def thresholds(self):
+        return np.array([3.0])
+
+    def update(self, x, fresh):
+        return np.abs(x[:1])
+
+
+def test_a_detector_without_init_has_no_parameters_and_meets_the_contract():
+    from alfa_bench.methods.checks import CHECKS
+
+    d = Sideslip()
+    assert d.get_params() == {} and d.channels() == ("sideslip",)
+    for check in CHECKS:
+        check(d)
+    with pytest.raises(NotImplementedError, match="define thresholds"):
+        RollError.thresholds(d)
+
+
 @pytest.fixture(scope="module")
 def local(corpus, tmp_path_factory):
     """The synthetic corpus loaded through the Python route, with the repository's
