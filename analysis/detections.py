@@ -18,8 +18,10 @@ from __future__ import annotations
 import json
 import logging
 from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from alfa_bench.data import (
@@ -47,6 +49,7 @@ from alfa_bench.outputs.provenance import provenance, read_table, run_provenance
 from .held_out import GROUPINGS, TooFewGroupsError, check_held_out, folds, groups_of
 from .isolation import isolate
 from .scoring import flight_outcome
+from .stability import pool_draws, pool_first_alarms
 from .traces import write_trace
 
 __all__ = ["INJECTED_RECORDS", "RUN_RECORD", "calibration_failure", "count_records",
@@ -65,12 +68,17 @@ INJECTED_RECORDS = "records.jsonl"
 
 def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest: pd.DataFrame,
                calibration: dict, failures: list[dict] | None = None,
-               calibrate_on: pd.DataFrame | None = None, detector: Detector | None = None
-               ) -> Iterator[tuple[dict, Trace]]:
+               calibrate_on: pd.DataFrame | None = None, detector: Detector | None = None,
+               stability: dict | None = None) -> Iterator[tuple[dict, Trace]]:
     """Records and traces (with probes) of ``spec`` (``{"detector": name, "params":
     {...}}``) on every flight of ``manifest`` with ground truth; ``calibration`` is
     ``{"group_by", "margin_s"}``. The detector run is ``detector`` if given (unfitted;
     ``spec`` then names it in the records), else the registry's ``spec``.
+
+    With ``stability`` (``{"pools", "seed"}``), each fold also draws that many pools of
+    its calibration flights (:func:`~.stability.pool_draws`), and each real flight's
+    record holds its first alarm under each pool's thresholds, where the detector can
+    set them without fitting again (``stability``; :mod:`.stability`).
 
     A calibrated method is fitted per fold on the other groups' flights of
     ``calibrate_on`` (default ``manifest``): injected flights are scored by the
@@ -88,7 +96,7 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
     sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
     sha |= dict(zip(train["flight"], train["sha256"], strict=True))
     runner = _FoldRunner(method, spec, detector, flights, sha, calibration, failures,
-                     _sources(manifest))
+                         _sources(manifest), stability, _fault_free_s(train, calibration))
     if not detector.calibrated:
         for name in manifest.loc[manifest["ground_truth"], "flight"]:
             if (out := runner.record(name)) is not None:
@@ -120,6 +128,15 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
                                              f"{sorted(scored_by_fold)}"))
 
 
+def _fault_free_s(manifest: pd.DataFrame, calibration: dict) -> dict[str, float]:
+    """Per flight, its seconds of fault-free flight as calibration takes them: all of a
+    fault-free flight, a faulty one's up to ``margin_s`` before onset."""
+    pre = manifest["pre_fault_s"].fillna(manifest["flight_s"]) - calibration["margin_s"]
+    free = manifest["fault_class"] == "none"
+    seconds = manifest["flight_s"].where(free, pre.clip(lower=0.0))
+    return dict(zip(manifest["flight"], seconds.astype(float), strict=True))
+
+
 def _sources(manifest: pd.DataFrame) -> dict[str, tuple[str, list[float]]]:
     """Per injected flight of ``manifest`` (``fault_source`` set), its source flight
     and the onsets of every flight injected into that source: where runs fork."""
@@ -145,12 +162,16 @@ class _FoldRunner:
 
     def __init__(self, method: str, spec: dict, detector: Detector,
                  flights: Mapping[str, Flight], sha: dict, calibration: dict,
-                 failures: list[dict] | None, sources: dict[str, tuple[str, list[float]]]):
+                 failures: list[dict] | None, sources: dict[str, tuple[str, list[float]]],
+                 stability: dict | None = None, fault_free_s: dict[str, float] | None = None):
         self.method, self.spec, self.detector = method, spec, detector
         self.flights, self.sha, self.calibration = flights, sha, calibration
         self.failures, self.sources = failures, sources
+        self.stability, self.fault_free_s = stability, fault_free_s or {}
         self.failed: set[str] = set()
         self.forks: dict[str, dict[float, Fork]] = {}
+        # the fold's pool thresholds (pools, channels), or None
+        self.pools: np.ndarray | None = None
 
     def guarded(self, stage: str, name: str, fn):
         """``fn()``, or None once flight ``name`` has bad data (at ``stage``)."""
@@ -169,7 +190,8 @@ class _FoldRunner:
     def record(self, name: str, info: dict | None = None) -> tuple[dict, Trace] | None:
         if name not in self.sources:
             return self.guarded("detect", name, lambda: detection_record(
-                self.method, self.spec, self.detector, self.flights[name], self.sha, info))
+                self.method, self.spec, self.detector, self.flights[name], self.sha, info,
+                pools=self.pools))
         source, onsets = self.sources[name]
         if source not in self.forks:
             self.forks[source] = self.guarded("detect", source, lambda: forks(
@@ -203,6 +225,7 @@ class _FoldRunner:
         data = [s for f in used for s in segments[f]]
         check_held_out(data, fold, scored, group)
         self.forks = {}                # run by the previous fold's fit
+        self.pools = None
         try:
             detector.fit(data)
         except CalibrationError as e:
@@ -210,12 +233,33 @@ class _FoldRunner:
                 f"fold {fold} ({len(used)} calibration flights): {e}"))
             return None
         log.info("%s: fold %s fitted on %d flights", self.method, fold, len(used))
+        if self.stability:
+            self.pools = self._pool_thresholds(fold, training, used, scored, group)
         return {**self.calibration, "fold": fold, "flights": used, "not_measured": dead,
+                "fault_free_hours": sum(self.fault_free_s[f] for f in used) / 3600.0,
                 "supervised": detector.supervised,
                 # what reached fit, flight by flight: the spans of its segments, s
                 "segments": {f: [[float(x.t[0]), float(x.t[-1])] for x in segments[f]]
                              for f in used},
                 "fitted": detector.fitted()}
+
+    def _pool_thresholds(self, fold: str, training: list[str], used: list[str],
+                         scored: list[str], group: dict[str, str]) -> np.ndarray | None:
+        """The fitted detector's thresholds under each pool of the fold's calibration
+        flights (:func:`~.stability.pool_draws`), those it used counted; None where
+        it cannot set them without a refit."""
+        draws = pool_draws(training, self.stability["pools"], self.stability["seed"], fold)
+        check_held_out([_Drawn(f) for d in draws for f in d], fold, scored, group)
+        kept = set(used)
+        return self.detector.pool_thresholds(
+            [{f: n for f, n in d.items() if f in kept} for d in draws])
+
+
+@dataclass(frozen=True)
+class _Drawn:
+    """A flight drawn into a pool, as :func:`~.held_out.check_held_out` reads it."""
+
+    flight: str
 
 
 def calibration_failure(flight: str, method: str, error: CalibrationError,
@@ -232,14 +276,19 @@ def calibration_failure(flight: str, method: str, error: CalibrationError,
 
 def detection_record(method: str, spec: dict, detector: Detector, flight: Flight,
                      sha256: dict[str, str], calibration: dict | None = None,
-                     forked: dict[float, Fork] | None = None) -> tuple[dict, Trace]:
+                     forked: dict[float, Fork] | None = None,
+                     pools: np.ndarray | None = None) -> tuple[dict, Trace]:
     """Run ``detector`` (fitted if calibrated) on ``flight``: its record and trace.
     ``sha256`` maps flights to their checksums; the record's provenance gives those of
     ``flight`` and of the flights that calibrated the detector.
 
     With ``forked`` (an injected flight: :func:`~alfa_bench.methods.forks` of its
     source, by time), the run continues from the latest fork at or before the onset,
-    and keeps no probes (an injected flight has no trace written)."""
+    and keeps no probes (an injected flight has no trace written).
+
+    With ``pools`` (thresholds per calibration pool and channel), the record's
+    ``stability`` holds the first alarm under each (:func:`~.stability.
+    pool_first_alarms`); None without."""
     if flight.fault is None:
         raise ValueError(f"flight {flight.id} has no ground truth and cannot be scored")
     onset = flight.fault.onset_s
@@ -280,6 +329,8 @@ def detection_record(method: str, spec: dict, detector: Detector, flight: Flight
                  "start_s": float(trace.t[0]), "stop_s": float(trace.t[-1])},
         "repairs": list(flight.repairs),
         "calibration": calibration,
+        "stability": None if pools is None else {
+            "pools": int(pools.shape[0]), "first_alarm_s": pool_first_alarms(trace, pools)},
         "provenance": provenance(spec, {
             "flight_sha256": sha256[flight.id],
             "calibration_sha256": ({f: sha256[f] for f in calibration["flights"]}
@@ -399,7 +450,7 @@ def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
     run = {"folds": {}, "calibration_sha256": {}}
     lines = {}
     for record, trace in detect_all(method, spec, flights, scored, calibration, failures,
-                                    calibrate_on=manifest):
+                                    calibrate_on=manifest, stability=config.get("stability")):
         name = record["flight"]
         if name in grid:
             lines[name] = json.dumps(_referencing(record, run), sort_keys=True,

@@ -262,7 +262,8 @@ def evaluate(detector: Detector | str, corpus: Corpus, *, name: str | None = Non
     # differs from the workflow's in its last digits
     with threadpool_limits(1, user_api="blas"):
         for record, trace in detect_all(name, spec, flights, scored, config["calibration"],
-                                        failed, calibrate_on=manifest, detector=detector):
+                                        failed, calibrate_on=manifest, detector=detector,
+                                        stability=config.get("stability")):
             if record["flight"] in on_grid:
                 extra.append(record)
             else:

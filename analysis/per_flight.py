@@ -22,6 +22,10 @@ time. ``margin_before`` is the largest before the onset (over the whole flight w
 fault-free): how near the flight came to a false alarm. A fault whose in-time margin is
 below the margins fault-free flying reaches has no signature this method can use at
 any threshold.
+
+``survival`` is the share of resampled calibration pools under which the outcome stays
+the one reported (:func:`~.stability.survival`; NaN for a run without pools): a
+detection near its threshold is luck until it survives the pools.
 """
 
 from __future__ import annotations
@@ -39,6 +43,7 @@ from alfa_bench.outputs.tables import BLOCK_MARKS, BLOCKS, block
 
 from .isolation import named_class, names_class
 from .scoring import flight_outcome
+from .stability import survival
 
 __all__ = ["margins", "per_flight_markdown", "per_flight_table", "verdict"]
 
@@ -116,7 +121,7 @@ def per_flight_table(records: list[dict], traces: Mapping[tuple[str, str], Trace
             "verdict": verdict(onset, first, channel, deadline_s,
                                (detected, r["fault_class"]) if other else None),
             "margin_in_time": in_time, "margin_channel": margin_channel,
-            "margin_before": before})
+            "margin_before": before, "survival": survival(r, deadline_s)})
     table = pd.DataFrame(rows)
     if table.empty:
         return table
@@ -136,12 +141,12 @@ def per_flight_markdown(table: pd.DataFrame, deadline_s: float) -> str:
         sections.append((f"`{method}`{mark}, deadline {deadline_s:g} s",
                          ["flight", "fault", "emr", "outcome", "what happened",
                           f"largest score/threshold, onset to +{deadline_s:g} s",
-                          "largest before onset"],
+                          "largest before onset", "survival over calibration pools"],
                          [[f"`{r['flight']}`", r["fault_class"],
                            "yes" if r["emergency_trajectory"] else "",
                            fmt(r["outcome"]), r["verdict"],
                            (f"{fmt(r['margin_in_time'])} ({r['margin_channel']})"
                             if isinstance(r["margin_channel"], str) else "-"),
-                           fmt(r["margin_before"])]
+                           fmt(r["margin_before"]), fmt(r["survival"])]
                           for r in rows.to_dict(orient="records")]))
     return markdown(sections)

@@ -201,6 +201,13 @@ class Detector(ABC):
         return self. A detector without running state need not define it."""
         return self
 
+    def pool_thresholds(self, pools: list[dict[str, int]]) -> np.ndarray | None:
+        """The thresholds :meth:`fit` would have set had its calibration flights been
+        drawn as each of ``pools`` says (flight -> times drawn, a bootstrap), all else
+        it learned kept: shape (pools, channels). None where the thresholds cannot be
+        set again without fitting the model again (the default)."""
+        return None
+
     def alarms(self, score: np.ndarray) -> np.ndarray:
         """Alarms of scores of shape (..., c): :math:`s_c(k) > \\gamma_c`; a NaN score
         (a channel not armed) never alarms."""

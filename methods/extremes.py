@@ -24,7 +24,8 @@ import numpy as np
 
 from .base import CalibrationError
 
-__all__ = ["CAP_LEVEL", "MIN_SEGMENTS", "MaximaThresholds", "gumbel_threshold"]
+__all__ = ["CAP_LEVEL", "MIN_SEGMENTS", "MaximaThresholds", "gumbel_threshold",
+           "gumbel_thresholds"]
 
 #: fewer per-flight maxima than this cannot fit a two-parameter law
 MIN_SEGMENTS = 3
@@ -62,6 +63,61 @@ def gumbel_threshold(maxima: np.ndarray, level: float) -> float:
     return float(stats.gumbel_r.ppf(level, loc, scale))
 
 
+def _weighted_quantile(x: np.ndarray, cum: np.ndarray, m: np.ndarray, p: float) -> np.ndarray:
+    """Per row, ``np.quantile`` (linear) of the sorted ``x`` repeated as the row's counts
+    say (``cum``: their cumulative sums, ``m``: their totals)."""
+    h = (m - 1) * p
+    lo = np.floor(h)
+    at = (cum <= lo[:, None]).sum(axis=1)                       # repeated index lo
+    above = (cum <= np.minimum(lo + 1, m - 1)[:, None]).sum(axis=1)
+    return x[at] + (h - lo) * (x[above] - x[at])
+
+
+def gumbel_thresholds(maxima: np.ndarray, counts: np.ndarray, level: float) -> np.ndarray:
+    r""":func:`gumbel_threshold` of many pools at once: pool :math:`b` holds maxima
+    :math:`x_i` ``counts[b, i]`` times (a bootstrap of the flights). Each pool's maxima
+    are capped as there, and the Gumbel law fitted by maximum likelihood, the scale
+    :math:`\beta` by Newton's method on
+
+    .. math::
+
+        \beta = \bar y - \frac{\sum_i w_i y_i e^{-y_i/\beta}}{\sum_i w_i e^{-y_i/\beta}},
+        \qquad \mu = -\beta \ln \frac{\sum_i w_i e^{-y_i/\beta}}{\sum_i w_i},
+
+    the equations scipy's ``gumbel_r.fit`` solves one pool at a time (a thousand
+    times slower). NaN for a pool of fewer than :data:`MIN_SEGMENTS` maxima."""
+    order = np.argsort(maxima)
+    x = np.asarray(maxima, dtype=float)[order]
+    w = np.asarray(counts, dtype=float)[:, order]
+    cum, m = np.cumsum(w, axis=1), w.sum(axis=1)
+    ok = m >= MIN_SEGMENTS
+    out = np.full(w.shape[0], np.nan)
+    if not ok.any() or x.size == 0:
+        return out
+    w, cum, m = w[ok], cum[ok], m[ok]
+    q1, q2, q3 = (_weighted_quantile(x, cum, m, p) for p in (0.25, 0.5, 0.75))
+    cap = q2 + (q3 - q1) * (_gumbel_unit(CAP_LEVEL) - _gumbel_unit(0.5)) / (
+        _gumbel_unit(0.75) - _gumbel_unit(0.25))
+    y = np.minimum(x[None, :], cap[:, None])
+    low = y.min(axis=1, keepdims=True)
+    mean = (w * y).sum(axis=1) / m
+    spread = np.sqrt(np.maximum((w * (y - mean[:, None]) ** 2).sum(axis=1) / m, 1e-24))
+    beta = spread * math.sqrt(6.0) / math.pi                    # the moments' estimate
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
+        for _ in range(60):
+            e = w * np.exp(-(y - low) / beta[:, None])
+            d0, d1, d2 = e.sum(axis=1), (e * y).sum(axis=1), (e * y * y).sum(axis=1)
+            tilted = d1 / d0
+            f = mean - beta - tilted                            # MLE equation of beta
+            slope = -1.0 - (d2 / d0 - tilted ** 2) / beta ** 2
+            beta = np.maximum(beta - f / slope, 1e-12)
+        e = w * np.exp(-(y - low) / beta[:, None])
+        gamma = low[:, 0] - beta * np.log(e.sum(axis=1) / m) + beta * _gumbel_unit(level)
+    # a pool of one value has no spread to fit: its threshold is that value
+    out[ok] = np.where(np.isfinite(gamma), gamma, y.max(axis=1))
+    return out
+
+
 class MaximaThresholds:
     r"""Per-channel thresholds from per-flight maxima (module docstring), for a
     :class:`~.base.Detector` with a ``false_alarm`` hyper-parameter :math:`\alpha`:
@@ -91,17 +147,19 @@ class MaximaThresholds:
     def fit(self, segments) -> MaximaThresholds:
         """:meth:`fit_model`, then the maxima of the scores of ``segments`` and
         :meth:`rethreshold`."""
-        for attr in ("maxima_", "gamma_"):
+        for attr in ("maxima_", "gamma_", "maxima_flights_"):
             self.__dict__.pop(attr, None)
         self.fit_model(segments)
         maxima = {c: [] for c in self.channels()}
+        flights = {c: [] for c in self.channels()}
         for s in segments:
             with np.errstate(invalid="ignore"):
                 score, _ = self.run(s)
             for c, column in zip(maxima, score.T, strict=True):
                 if np.isfinite(column).any():
                     maxima[c].append(float(np.nanmax(column)))
-        self.maxima_ = maxima
+                    flights[c].append(s.flight)
+        self.maxima_, self.maxima_flights_ = maxima, flights
         return self.rethreshold()
 
     def rethreshold(self) -> MaximaThresholds:
@@ -127,6 +185,21 @@ class MaximaThresholds:
     def thresholds(self) -> np.ndarray:
         self._check_fitted("gamma_")
         return np.array([self.gamma_[c] for c in self.channels()])
+
+    def pool_thresholds(self, pools: list[dict[str, int]]) -> np.ndarray:
+        """Per pool (flight -> how many times it was drawn) and channel, the threshold
+        from the maxima of the flights drawn: the bootstrap of :meth:`fit`'s
+        thresholds, all else it learned kept. Shape (pools, channels); NaN where a
+        pool holds too few maxima of a channel."""
+        self._check_fitted("gamma_")
+        level = 1.0 - self.false_alarm / len(self.maxima_)
+        out = np.empty((len(pools), len(self.maxima_)))
+        for j, c in enumerate(self.channels()):
+            counts = np.array([[pool.get(f, 0) for f in self.maxima_flights_[c]]
+                               for pool in pools])
+            out[:, j] = np.maximum(gumbel_thresholds(np.array(self.maxima_[c]), counts,
+                                                     level), 1e-9)
+        return out
 
     def fitted(self) -> dict:
         """The maxima and the thresholds, per channel."""

@@ -283,6 +283,11 @@ class NestedSelection(Detector):
         self._check_fitted("base_")
         return self.base_.thresholds()
 
+    def pool_thresholds(self, pools: list[dict[str, int]]) -> np.ndarray | None:
+        """The chosen base's (the choice itself kept)."""
+        self._check_fitted("base_")
+        return self.base_.pool_thresholds(pools)
+
     def probes(self) -> dict[str, float]:
         return self.base_.probes() if hasattr(self, "base_") else self._reference().probes()
 

@@ -34,6 +34,7 @@ import pandas as pd
 from alfa_bench.analysis.isolation import names_class
 from alfa_bench.analysis.reference import ICRA2019_BY_FAULT, ICRA2019_NAME, ICRA2019_SUMMARY
 from alfa_bench.analysis.scoring import mcnemar_exact, score_records
+from alfa_bench.analysis.stability import pool_rank_keys, stability_table
 from alfa_bench.data import FAILURE_COLUMNS, FAULT_CLASSES, subset_flights
 
 from .render import Section, fmt, latex_tables, markdown
@@ -41,7 +42,8 @@ from .render import Section, fmt, latex_tables, markdown
 __all__ = ["BLOCKS", "BLOCK_MARKS", "FAULT_ORDER", "SIGNIFICANCE", "block", "by_fault_latex",
            "by_fault_markdown", "by_fault_table", "comparison_latex", "comparison_markdown",
            "comparison_notes", "comparison_table", "configurations", "failures_table",
-           "summary_latex", "summary_markdown", "summary_table", "unscored_notes"]
+           "stability_markdown", "summary_latex", "summary_markdown", "summary_table",
+           "unscored_notes"]
 
 #: ALFA's fault classes in the tables' order (the injected sensor faults are scored apart)
 FAULT_ORDER = tuple(c for c in FAULT_CLASSES if c != "sensor")
@@ -153,7 +155,8 @@ def _isolation(recs: list[dict], outcomes: list[str]) -> tuple[int, int]:
 
 
 def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadline_s: float,
-                     failures: pd.DataFrame | None = None) -> pd.DataFrame:
+                     failures: pd.DataFrame | None = None, stable: float = 0.9,
+                     interval: float = 0.9) -> pd.DataFrame:
     """Per subset and method, in block order (honest ones ranked): the scores under the
     deadline and by the paper's rule, false alarms on fault-free flights, the
     calibration protocol, the flights excluded, and the exact McNemar test against the
@@ -162,7 +165,14 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
     Ranks compare like with like: an honest run is ranked only if it scored every
     flight that any honest run scored of the subset, and armed on at least one;
     otherwise ``not_ranked`` says why (``scored on k of n``, ``never armed``) and it
-    follows the ranked ones, without a rank."""
+    follows the ranked ones, without a rank.
+
+    Under resampled calibration pools (:mod:`alfa_bench.analysis.stability`): the
+    stable detections (survival at least ``stable``), the central ``interval`` of the
+    in-time detections over the pools, and ``rank_range``, the ranks a ranked run
+    takes over the pools (the other ranked runs re-scored under the same pools)."""
+    pooled = stability_table(records, manifest, subsets, deadline_s, stable, interval
+                             ).set_index(["subset", "method"])
     rows = []
     for subset in subsets:
         runs = []
@@ -184,11 +194,15 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
                                      for r in recs),
                 "isolation": named / hits if hits else math.nan,
                 "excluded": len(excluded),
-            }))
-        honest = sorted((r for r in runs if r[1]["block"] == "honest"),
+                **{k: pooled.at[(subset, method), k]
+                   for k in ("stable_detections", "detections_low", "detections_high")},
+            }, recs))
+        honest = sorted((r[:2] for r in runs if r[1]["block"] == "honest"),
                         key=lambda r: (-_num(r[1]["accuracy"]), -_num(r[1]["recall"]),
                                        _num(r[1]["mean_detection_s"], math.inf)))
         common = set().union(*(set(c) for c, _ in honest))
+        recs_of = {row["method"]: recs for _, row, recs in runs}
+        runs = [r[:2] for r in runs]
         for correct, row in runs:
             row["not_ranked"] = ("" if row["block"] != "honest" else
                                  f"scored on {len(correct)} of {len(common)}"
@@ -197,6 +211,7 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
         ranked = [r for r in honest if not r[1]["not_ranked"]]
         for i, (_, row) in enumerate(ranked, 1):
             row["rank"] = i
+        _rank_ranges([row for _, row in ranked], recs_of, deadline_s)
         ordered = ranked + [r for r in honest if r[1]["not_ranked"]] + [
             r for b in BLOCKS[1:] for r in runs if r[1]["block"] == b]
         best_correct, best = ranked[0] if ranked else ({}, None)
@@ -210,6 +225,27 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
             row["vs_best_p"] = test["p_value"]
             rows.append(row)
     return pd.DataFrame(rows)
+
+
+def _rank_ranges(ranked: list[dict], recs_of: dict[str, list[dict]], deadline_s: float) -> None:
+    """Each ranked row's ``rank_range``: its lowest and highest rank when every ranked
+    run is re-scored under each calibration pool (``"3"``, ``"2-5"``); its rank where
+    no run has pools."""
+    pools = max((len(r["stability"]["first_alarm_s"]) for row in ranked
+                 for r in recs_of[row["method"]][:1] if r.get("stability")), default=0)
+    for row in ranked:
+        row["rank_range"] = str(row["rank"])
+    if not pools:
+        return
+    keys = [pool_rank_keys(recs_of[row["method"]], deadline_s, pools) for row in ranked]
+    seen = [[] for _ in ranked]
+    for b in range(pools):
+        # ties keep the reported order, as the reported ranking does
+        for place, i in enumerate(sorted(range(len(ranked)), key=lambda i: keys[i][b]), 1):
+            seen[i].append(place)
+    for row, places in zip(ranked, seen, strict=True):
+        low, high = min(places), max(places)
+        row["rank_range"] = str(low) if low == high else f"{low}-{high}"
 
 
 def _num(v, nan=-math.inf) -> float:
@@ -289,6 +325,7 @@ def _summary_sections(summary: pd.DataFrame) -> list[Section]:
             return [name, fmt(r.get("flights")), fmt(r.get("excluded")), fmt(r.get("tp")),
                     fmt(r.get("fp")), fmt(r.get("fn")), fmt(r.get("tn")),
                     _rate(r, "precision"), _rate(r, "recall"), _rate(r, "accuracy"),
+                    _stable(r), r["rank_range"] if isinstance(r.get("rank_range"), str) else "-",
                     fmt(r.get("mean_detection_s")), fmt(r.get("max_detection_s")),
                     fmt(r["tp_paper"]), fmt(r["fp_paper"]), fmt(r["fn_paper"]),
                     fmt(r["tn_paper"]), _rate(r, "accuracy_paper"),
@@ -341,6 +378,17 @@ SUBSET_NOTES = {
 }
 
 
+def _stable(r) -> str:
+    """In-time detections, stable ones and their interval over the calibration pools:
+    ``7: 3 stable [4, 8]``; the count alone where the run has no pools."""
+    if fmt(r.get("tp")) == "-":
+        return "-"
+    if fmt(r.get("stable_detections")) == "-":
+        return f"{int(r['tp'])} (no pools)"
+    return (f"{int(r['tp'])}: {int(r['stable_detections'])} stable "
+            f"[{fmt(r['detections_low'], digits=0)}, {fmt(r['detections_high'], digits=0)}]")
+
+
 def _comparison_sections(comparison: pd.DataFrame, primary: str | None = None
                          ) -> list[Section]:
     out = []
@@ -348,6 +396,8 @@ def _comparison_sections(comparison: pd.DataFrame, primary: str | None = None
         d = _deadline(table)
         header = ["rank", "method", "detector", "calibration", f"precision % ≤{d} s [95 % CI]",
                   f"recall % ≤{d} s [95 % CI]", f"accuracy % ≤{d} s [95 % CI]",
+                  f"detections ≤{d} s: stable [interval over calibration pools]",
+                  "rank over calibration pools",
                   "mean det. s", "max det. s", "accuracy % (paper's rule)",
                   "mean det. s (paper's rule)", "false alarms, fault-free flights",
                   "in-time detections first on the fault's axis %",
@@ -366,6 +416,7 @@ def _comparison_sections(comparison: pd.DataFrame, primary: str | None = None
                     r["method"], r["detector"],
                     r["calibration"],
                     _rate(r, "precision"), _rate(r, "recall"), _rate(r, "accuracy"),
+                    _stable(r), r["rank_range"] if isinstance(r.get("rank_range"), str) else "-",
                     fmt(r.get("mean_detection_s")), fmt(r.get("max_detection_s")),
                     fmt(r["accuracy_paper"], True), fmt(r["mean_detection_s_paper"]),
                     f"{r['fault_free_false_alarms']} of {r['fault_free_flights']}",
@@ -466,3 +517,37 @@ def comparison_markdown(comparison: pd.DataFrame, unscored: str = "", primary: s
 def comparison_latex(comparison: pd.DataFrame) -> str:
     """:func:`comparison_markdown` as LaTeX (booktabs)."""
     return latex_tables(_comparison_sections(comparison), "comparison")
+
+
+def stability_markdown(stability: pd.DataFrame, folds: pd.DataFrame, settings: dict) -> str:
+    """The stability table per subset (:func:`~alfa_bench.analysis.stability.
+    stability_table`), then each fold's calibration data (:func:`~alfa_bench.analysis.
+    stability.calibration_table`); ``settings`` is the config's ``stability``."""
+    level = fmt(100 * settings["interval"], digits=0)
+    sections = []
+    for subset, table in stability.groupby("subset", sort=False):
+        d = _deadline(table)
+        header = ["method", f"detections ≤{d} s", f"stable (survival ≥ {settings['stable']:g})",
+                  f"over the pools: mean [{level} % interval]", "fault-free alarms",
+                  f"over the pools: mean [{level} % interval]", "pools"]
+        rows = [[r["method"], str(r["detections"]), fmt(r["stable_detections"], digits=0),
+                 "-" if not r["pools"] else
+                 f"{fmt(r['detections_mean'], digits=1)} [{fmt(r['detections_low'], digits=0)}"
+                 f", {fmt(r['detections_high'], digits=0)}]",
+                 f"{r['fault_free_alarms']} of {r['fault_free_flights']}",
+                 "-" if not r["pools"] else
+                 f"{fmt(r['fault_free_alarms_mean'], digits=1)} "
+                 f"[{fmt(r['fault_free_alarms_low'], digits=0)}, "
+                 f"{fmt(r['fault_free_alarms_high'], digits=0)}]",
+                 str(r["pools"]) if r["pools"] else "none: not calibrated, or its thresholds "
+                 "come with a fitted model"]
+                for r in table.to_dict(orient="records")]
+        sections.append((f"Subset `{subset}` (deadline {d} s)", header, rows))
+    sections.append(("Calibration data per fold", ["fold (left out)", "calibration flights",
+                                                   "fault-free hours",
+                                                   "smallest per-flight false-alarm level "
+                                                   "they can check"],
+                     [[r["fold"], str(r["flights"]), fmt(r["fault_free_hours"]),
+                       fmt(r["smallest_level"], digits=3)]
+                      for r in folds.to_dict(orient="records")]))
+    return markdown(sections)

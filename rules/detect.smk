@@ -19,6 +19,7 @@ rule detect_reference:
         # canonical JSON, so that only a changed value (not a reordered key) re-runs it
         spec=lambda w: json.dumps(config["methods"][w.method], sort_keys=True),
         calibration=config["calibration"],
+        stability=config["stability"],
         strict=config["strict"],
     log:
         "results/logs/detect/{method}.log",
@@ -47,6 +48,7 @@ use rule detect_reference as detect with:
     params:
         spec=lambda w: json.dumps(config["methods"][w.method], sort_keys=True),
         calibration=config["calibration"],
+        stability=config["stability"],
         strict=config["strict"],
         injection=config["injection"],
         processed=INJECTED_PROCESSED,

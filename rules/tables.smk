@@ -19,10 +19,16 @@ rule tables:
         summary_tex="results/tables/summary.tex",
         by_fault_tex="results/tables/by_fault.tex",
         comparison_tex="results/tables/comparison.tex",
+        # how much each outcome owes to the calibration flights (analysis/stability.py)
+        stability="results/tables/stability.csv",
+        stability_md=report("results/tables/stability.md", caption="../report/stability.rst",
+                            category="Comparison"),
+        calibration="results/tables/calibration.csv",
     params:
         subsets=SUBSETS,
         primary=PRIMARY,
         deadline_s=config["scoring"]["deadline_s"],
+        stability=config["stability"],
     log:
         "results/logs/tables.log",
     benchmark:

@@ -20,10 +20,11 @@ from alfa_bench.analysis import (
     summary_table,
 )
 from alfa_bench.analysis.leakage import audit_note
+from alfa_bench.analysis.stability import calibration_table, stability_table
 from alfa_bench.data import read_manifest
 from alfa_bench.outputs.provenance import read_table, run_provenance, stamp
 from alfa_bench.outputs.render import markdown_html
-from alfa_bench.outputs.tables import unscored_notes
+from alfa_bench.outputs.tables import stability_markdown, unscored_notes
 from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821
@@ -36,7 +37,15 @@ failures.to_csv(sm.output.failures, index=False)
 deadline = float(sm.params.deadline_s)
 summary = summary_table(records, manifest, sm.params.subsets, deadline, failures)
 by_fault = by_fault_table(records, manifest, sm.params.subsets, deadline, failures)
-comparison = comparison_table(records, manifest, sm.params.subsets, deadline, failures)
+stability = sm.params.stability
+comparison = comparison_table(records, manifest, sm.params.subsets, deadline, failures,
+                              stability["stable"], stability["interval"])
+pooled = stability_table(records, manifest, sm.params.subsets, deadline, stability["stable"],
+                         stability["interval"])
+pooled.to_csv(sm.output.stability, index=False)
+folds = calibration_table(records)
+folds.to_csv(sm.output.calibration, index=False)
+Path(sm.output.stability_md).write_text(stability_markdown(pooled, folds, stability))
 summary.to_csv(sm.output.summary, index=False)
 by_fault.to_csv(sm.output.by_fault, index=False)
 comparison.to_csv(sm.output.comparison, index=False)
