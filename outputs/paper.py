@@ -36,7 +36,17 @@ sensor faults: ``sensorfaults`` (injected flights scored), ``sensordetected:<m>`
 candidates of a nested selection, else 1); from the detectability ceiling
 (:mod:`.ceiling`): ``ceilingfeature:<s>:<c>``, ``ceilingauc:<s>:<c>`` and
 ``ceilingreach:<s>:<c>`` (the best single feature of class ``c``, its AUC, and "k of n"
-faults above every fault-free maximum); ``paper:precision``,
+faults above every fault-free maximum); under resampled calibration pools
+(:mod:`alfa_bench.analysis.stability`): ``stable:<m>:<s>`` (in-time detections that
+survive at least the configured share of the pools; "n/a" without pools),
+``detectedpools:<m>:<s>`` (the interval of the in-time detections over the pools,
+"lo-hi"), ``rankrange:<m>:<s>`` (its ranks over the pools), ``beststable:<s>`` (the
+best honest run's stable detections), ``calflights`` and ``calhours`` (the fewest and
+most calibration flights of a fold, and their fault-free hours, "lo-hi"),
+``callevel`` (the largest, over the folds, of the smallest per-flight false-alarm
+level a fold's flights can check), ``pools`` and ``stableshare`` (the pools each fold
+draws, and the share of them a stable detection survives, %; the config's
+``stability``); ``paper:precision``,
 ``paper:recall``, ``paper:accuracy``, ``paper:meandet``, ``paper:maxdet`` (Keipour et
 al. 2019, quoted).
 """
@@ -74,7 +84,8 @@ def _sec(v: float) -> str:
 
 #: the keys of one run on one subset, "n/a" for a configured run with no score there
 _PER_RUN = ("precision", "recall", "accuracy", "accuracypaper", "recallpaper", "detected",
-            "meandet", "maxdet", "falsealarms", "recallnofa")
+            "meandet", "maxdet", "falsealarms", "recallnofa", "stable", "detectedpools",
+            "rankrange")
 
 
 def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.DataFrame,
@@ -82,7 +93,9 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.Dat
                   per_flight: pd.DataFrame | None = None,
                   methods=(), subsets=(), sensors: dict | None = None,
                   primary: str | None = None,
-                  ceiling: pd.DataFrame | None = None) -> dict[str, str]:
+                  ceiling: pd.DataFrame | None = None,
+                  calibration: pd.DataFrame | None = None,
+                  stability: dict | None = None) -> dict[str, str]:
     """Every quotable number, as text, by key (see the module docstring). A configured
     run (``methods``) with no score on a subset (``subsets``), because every flight of
     it was excluded, quotes "n/a". ``sensors`` holds the ``detectability``,
@@ -110,6 +123,12 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.Dat
         out[f"maxdet:{m}:{s}"] = _sec(r["max_detection_s"])
         out[f"falsealarms:{m}:{s}"] = (f"{r['fault_free_false_alarms']} of "
                                        f"{r['fault_free_flights']}")
+        pooled = not pd.isna(r.get("stable_detections", math.nan))
+        out[f"stable:{m}:{s}"] = str(int(r["stable_detections"])) if pooled else "n/a"
+        out[f"detectedpools:{m}:{s}"] = (
+            f"{int(r['detections_low'])}-{int(r['detections_high'])}" if pooled else "n/a")
+        rank = r.get("rank_range")
+        out[f"rankrange:{m}:{s}"] = rank if isinstance(rank, str) else "n/a"
     out["primary"] = primary or "none"
     for s, table in comparison.groupby("subset", sort=False):
         best = table[table["rank"] == 1]
@@ -119,6 +138,8 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.Dat
                                     if len(best) else "n/a")
         out[f"bestfalsealarms:{s}"] = (out[f"falsealarms:{best['method'].iloc[0]}:{s}"]
                                        if len(best) else "n/a")
+        out[f"beststable:{s}"] = (out[f"stable:{best['method'].iloc[0]}:{s}"]
+                                  if len(best) else "n/a")
         tied = table[(table["vs_best_p"] >= SIGNIFICANCE) & (table["block"] == "honest")]
         out[f"tied:{s}"] = ", ".join(tied["method"]) or "none"
     for (m, s), table in sweep.groupby(["method", "subset"], sort=False):
@@ -130,6 +151,9 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.Dat
     if "configurations" in comparison:
         for m, n in comparison.groupby("method")["configurations"].max().items():
             out[f"configurations:{m}"] = str(int(n))
+    out |= _calibration_numbers(calibration)
+    out |= {"pools": str(stability["pools"]) if stability else "n/a",
+            "stableshare": f"{100 * stability['stable']:g}" if stability else "n/a"}
     out |= _ceiling_numbers(ceiling, [*dict.fromkeys([*subsets, *comparison["subset"]])])
     # every run, subset and class first, so that a flight set without some still renders
     out |= {f"classdetected:{m}:{s}:{c}": "n/a" for m in runs
@@ -152,6 +176,16 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.Dat
             if rows["margin_before"].notna().any():
                 out[f"marginbefore:{m}"] = f"{rows['margin_before'].max():.2f}"
     return out | sensor_numbers(sensors or {}, runs)
+
+
+def _calibration_numbers(calibration: pd.DataFrame | None) -> dict[str, str]:
+    """The folds' calibration data (``calflights``, ``calhours``, ``callevel``)."""
+    if calibration is None or calibration.empty:
+        return {"calflights": "n/a", "calhours": "n/a", "callevel": "n/a"}
+    flights, hours = calibration["flights"], calibration["fault_free_hours"]
+    return {"calflights": f"{flights.min()}-{flights.max()}",
+            "calhours": f"{hours.min():.2f}-{hours.max():.2f}",
+            "callevel": f"{calibration['smallest_level'].max():.3f}"}
 
 
 def _ceiling_numbers(ceiling: pd.DataFrame | None, subsets) -> dict[str, str]:

@@ -28,6 +28,7 @@ rule paper_sources:
         sweep="results/tables/sweep.csv",
         leakage="results/tables/leakage.csv",
         ceiling="results/tables/ceiling.csv",
+        calibration="results/tables/calibration.csv",
         tex=PAPER_DIR / "paper.tex",
         markdown=PAPER_DIR / "paper.template.md",
     output:

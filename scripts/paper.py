@@ -15,7 +15,9 @@ numbers = paper_numbers(read_table(sm.input.comparison), read_table(sm.input.swe
                         subsets=sm.config["subsets"], primary=sm.config["primary_subset"],
                         sensors={k: read_table(sm.input[k]) for k in (
                             "detectability", "isolation_sensors", "isolation_actuators")},
-                        ceiling=read_table(sm.input.ceiling))
+                        ceiling=read_table(sm.input.ceiling),
+                        calibration=read_table(sm.input.calibration),
+                        stability=sm.config["stability"])
 unknown = latex_keys(Path(sm.input.tex).read_text()) - set(numbers)
 if unknown:
     raise KeyError(f"{sm.input.tex} quotes results no run defines: {sorted(unknown)}")
