@@ -19,11 +19,16 @@ the reported in-time detections and fault-free alarms beside their mean and inte
 over the pools; :func:`calibration_table` what each fold was calibrated on: its
 flights, their hours of fault-free flight, and the smallest per-flight false-alarm
 level that many flights can check (one in as many as there are).
+
+Whether the thresholds alone are the spread: :func:`refit_first_alarms` fits the model
+again on the first pools too, and :func:`refit_table` puts both side by side
+(``snakemake stability_refit``, not part of ``all``: a fit per pool and fold).
 """
 
 from __future__ import annotations
 
 import hashlib
+import logging
 import math
 
 import numpy as np
@@ -35,7 +40,10 @@ from alfa_bench.methods import Trace
 from .scoring import flight_outcome
 
 __all__ = ["calibration_table", "pool_counts", "pool_draws", "pool_first_alarms",
-           "pool_outcomes", "pool_rank_keys", "stability_table", "survival"]
+           "pool_outcomes", "pool_rank_keys", "refit_first_alarms", "refit_table",
+           "stability_table", "survival"]
+
+log = logging.getLogger(__name__)
 
 
 def pool_draws(flights: list[str], pools: int, seed: int, fold: str) -> list[dict[str, int]]:
@@ -178,3 +186,82 @@ def calibration_table(records: list[dict]) -> pd.DataFrame:
                                   "smallest_level": 1 / len(cal["flights"])}
     return pd.DataFrame(sorted(folds.values(), key=lambda f: f["fold"]),
                         columns=["fold", "flights", "fault_free_hours", "smallest_level"])
+
+
+def refit_first_alarms(spec: dict, flights, manifest: pd.DataFrame, calibration: dict,
+                       settings: dict, refits: int) -> dict[str, list[float | None]]:
+    """Per labelled flight of ``manifest``, its first alarm under each of the first
+    ``refits`` pools of its fold (:func:`pool_draws`, as the detect job draws them),
+    the detector of ``spec`` fitted again on each pool (a flight drawn twice calibrates
+    twice): what the pool moves, the model included. None where the pool cannot
+    calibrate it (logged), or it alarms nowhere."""
+    from alfa_bench.methods import (
+        CalibrationError,
+        make_detector,
+        run_detector,
+        training_segments,
+    )
+
+    from .held_out import GROUPINGS, check_held_out, folds
+
+    group = dict(zip(manifest["flight"], manifest[GROUPINGS[calibration["group_by"]]]
+                     .astype(str), strict=True))
+    out: dict[str, list[float | None]] = {}
+    segments: dict[str, list] = {}
+    for fold, (scored, training) in folds(manifest, calibration["group_by"]).items():
+        draws = pool_draws(training, settings["pools"], settings["seed"], fold)[:refits]
+        out |= {f: [] for f in scored}
+        for draw in draws:
+            detector = make_detector(spec["detector"], spec.get("params"))
+            for f in draw:
+                if f not in segments:
+                    segments[f] = training_segments(detector, [flights[f]],
+                                                    calibration["margin_s"])
+            data = [s for f, n in draw.items() for _ in range(n) for s in segments[f]]
+            check_held_out(data, fold, scored, group)
+            try:
+                # a pool of a few flights drawn many times can have no spread to fit
+                with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+                    detector.fit(data)
+            except CalibrationError as e:
+                log.warning("fold %s: a pool cannot calibrate %s: %s", fold,
+                            spec["detector"], e)
+                detector = None
+            for f in scored:
+                out[f].append(None if detector is None else
+                              run_detector(detector, flights[f]).first_alarm_s())
+    return out
+
+
+def refit_table(records: list[dict], refitted: dict[str, dict[str, list]],
+                manifest: pd.DataFrame, subsets, deadline_s: float) -> pd.DataFrame:
+    """Per run of ``refitted`` (run -> :func:`refit_first_alarms`) and subset: over the
+    same pools, the in-time detections when only the thresholds move (the records'
+    ``stability``) and when the model is fitted again, their spread, and the share of
+    (flight, pool) outcomes the two agree on."""
+    rows = []
+    for method, firsts in refitted.items():
+        recs = {r["flight"]: r for r in records if r["method"] == method}
+        refits = len(next(iter(firsts.values())))
+        for subset in subsets:
+            member = [f for f in subset_flights(manifest, subset) if f in recs]
+            cheap = np.zeros(refits)
+            full = np.zeros(refits)
+            agree = 0
+            for f in member:
+                r = recs[f]
+                for b in range(refits):
+                    a = flight_outcome(r["onset_s"], r["stability"]["first_alarm_s"][b],
+                                       deadline_s)
+                    c = flight_outcome(r["onset_s"], firsts[f][b], deadline_s)
+                    cheap[b] += a == "TP"
+                    full[b] += c == "TP"
+                    agree += a == c
+            rows.append({"method": method, "subset": subset, "deadline_s": deadline_s,
+                         "pools": refits, "thresholds_mean": cheap.mean(),
+                         "thresholds_min": cheap.min(), "thresholds_max": cheap.max(),
+                         "thresholds_sd": cheap.std(), "refit_mean": full.mean(),
+                         "refit_min": full.min(), "refit_max": full.max(),
+                         "refit_sd": full.std(),
+                         "outcomes_agree": agree / (len(member) * refits)})
+    return pd.DataFrame(rows)

@@ -42,8 +42,8 @@ from .render import Section, fmt, latex_tables, markdown
 __all__ = ["BLOCKS", "BLOCK_MARKS", "FAULT_ORDER", "SIGNIFICANCE", "block", "by_fault_latex",
            "by_fault_markdown", "by_fault_table", "comparison_latex", "comparison_markdown",
            "comparison_notes", "comparison_table", "configurations", "failures_table",
-           "stability_markdown", "summary_latex", "summary_markdown", "summary_table",
-           "unscored_notes"]
+           "refit_markdown", "stability_markdown", "summary_latex", "summary_markdown",
+           "summary_table", "unscored_notes"]
 
 #: ALFA's fault classes in the tables' order (the injected sensor faults are scored apart)
 FAULT_ORDER = tuple(c for c in FAULT_CLASSES if c != "sensor")
@@ -550,4 +550,23 @@ def stability_markdown(stability: pd.DataFrame, folds: pd.DataFrame, settings: d
                      [[r["fold"], str(r["flights"]), fmt(r["fault_free_hours"]),
                        fmt(r["smallest_level"], digits=3)]
                       for r in folds.to_dict(orient="records")]))
+    return markdown(sections)
+
+
+def refit_markdown(table: pd.DataFrame) -> str:
+    """:func:`~alfa_bench.analysis.stability.refit_table` per subset: the in-time
+    detections over the same pools, thresholds alone against the model fitted again."""
+    sections = []
+    for subset, rows in table.groupby("subset", sort=False):
+        d = _deadline(rows)
+        header = ["method", "pools", f"detections ≤{d} s, thresholds alone: mean [min, max]",
+                  "SD", "model fitted again: mean [min, max]", "SD",
+                  "(flight, pool) outcomes the two agree on %"]
+        sections.append((f"Subset `{subset}` (deadline {d} s)", header, [
+            [r["method"], str(r["pools"]),
+             f"{r['thresholds_mean']:.1f} [{r['thresholds_min']:.0f}, "
+             f"{r['thresholds_max']:.0f}]", f"{r['thresholds_sd']:.2f}",
+             f"{r['refit_mean']:.1f} [{r['refit_min']:.0f}, {r['refit_max']:.0f}]",
+             f"{r['refit_sd']:.2f}", fmt(r["outcomes_agree"], True, 1)]
+            for r in rows.to_dict(orient="records")]))
     return markdown(sections)

@@ -37,6 +37,29 @@ rule tables:
         "../scripts/tables.py"
 
 
+# The model fitted again on calibration pools, beside the thresholds alone; an explicit
+# target (`snakemake stability_refit`), never part of `all`: a fit per pool and fold.
+rule stability_refit:
+    input:
+        manifest="results/flights.csv",
+        cache="results/cache",
+        detections=expand("results/detections/{method}",
+                          method=config["stability"]["refit"]["runs"]),
+    output:
+        csv="results/tables/stability_refit.csv",
+        md="results/tables/stability_refit.md",
+    params:
+        specs={m: config["methods"][m] for m in config["stability"]["refit"]["runs"]},
+        calibration=config["calibration"],
+        stability=config["stability"],
+        subsets=SUBSETS,
+        deadline_s=config["scoring"]["deadline_s"],
+    log:
+        "results/logs/stability_refit.log",
+    script:
+        "../scripts/stability_refit.py"
+
+
 rule per_flight:
     input:
         manifest="results/flights.csv",

@@ -135,3 +135,20 @@ def test_no_pool_holds_a_flight_of_the_date_it_scores(local, monkeypatch):
     monkeypatch.setattr(detections, "pool_draws", leaky)
     with pytest.raises(HeldOutError, match="calibration would see"):
         ab.evaluate("coincidence", local)
+
+
+def test_a_refit_on_the_same_pools_sits_beside_the_thresholds_alone(local):
+    from alfa_bench.analysis.stability import refit_first_alarms, refit_table
+
+    config = local.config
+    result = ab.evaluate("residual_bank", local)
+    spec = config["methods"]["residual_bank"]
+    firsts = refit_first_alarms(spec, local.flights, local.manifest, config["calibration"],
+                                config["stability"], refits=3)
+    assert set(firsts) == {r["flight"] for r in result.records}
+    assert {len(v) for v in firsts.values()} == {3}
+    table = refit_table(result.records, {"residual_bank": firsts}, local.manifest,
+                        ["all"], 5.0)
+    row = table.iloc[0]
+    assert row["pools"] == 3 and 0 <= row["outcomes_agree"] <= 1
+    assert row["thresholds_min"] <= row["thresholds_mean"] <= row["thresholds_max"]
