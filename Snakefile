@@ -2,12 +2,18 @@
 # Run: snakemake all --cores 2   (with ALFA_DIR set, or the archive is downloaded)
 from snakemake.utils import min_version, validate
 
+from alfa_bench.workflow.checks import config_problem, stop
+
 min_version("9.0")
 
 
 configfile: "config/config.yaml"
 
 
+# a wrong key or value ends the run on what it is and where, not on the schema
+if _problem := config_problem(config, f"{workflow.basedir}/config/schema.yaml",
+                              workflow.configfiles):
+    stop(_problem)
 validate(config, "config/schema.yaml")
 
 

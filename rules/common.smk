@@ -5,6 +5,7 @@ from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
 
+from alfa_bench.workflow.checks import alfa_dir_problem, failure_message, stop
 from alfa_bench.workflow.dependencies import module_sources
 from alfa_bench.outputs.provenance import RUN_FILE
 from alfa_bench.data import SIGNALS, resolve_alfa_dir
@@ -66,6 +67,11 @@ def figure_fault_class(wildcards):
 
 # ALFA_DIR, else the config's alfa_dir, else the downloaded archive.
 _alfa = resolve_alfa_dir(config.get("alfa_dir"))
+# who named the folder, for the messages that end a run on it
+ALFA_SOURCE = ("ALFA_DIR" if os.environ.get("ALFA_DIR") else
+               "the config's alfa_dir" if _alfa is not None else "the download's dest")
+if _alfa is not None and (_why := alfa_dir_problem(_alfa, ALFA_SOURCE)):
+    stop(_why)
 DOWNLOAD = _alfa is None
 ALFA_DIR = Path(config["download"]["dest"]) if DOWNLOAD else _alfa
 PROCESSED = ALFA_DIR / "processed"

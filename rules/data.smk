@@ -1,12 +1,11 @@
-if DOWNLOAD:
+# a failed download, or a folder without a flight that reads, ends the run on what to do:
+# its message last, the details in its log (Snakemake's own lines come before)
+onerror:
+    if _last := failure_message(ALFA_SOURCE, ALFA_DIR):
+        print(f"\n{_last}", file=sys.stderr)
 
-    # a failed download ends the run on what to do: its message last, the details in
-    # its log (Snakemake's own lines come before)
-    onerror:
-        _log = Path("results/logs/download_alfa.log")
-        if _log.exists() and "download failed: " in _log.read_text():
-            _why = _log.read_text().split("download failed: ", 1)[1].split("\n", 1)[0]
-            print(f"\nThe ALFA download failed: {_why}\nDetails: {_log}", file=sys.stderr)
+
+if DOWNLOAD:
 
     rule download_alfa:
         output:

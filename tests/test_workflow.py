@@ -538,6 +538,66 @@ def test_a_failed_download_ends_on_what_to_do_without_a_traceback(tmp_path):
     assert "Traceback" in log and "cannot reach" in log
 
 
+#: Snakemake's own closing lines after a failed job (the onerror message comes before)
+SNAKEMAKE_FOOTER = ("Complete log", "Elapsed time", "WorkflowError:",
+                    "At least one job did not complete")
+
+
+def _last_lines(done: subprocess.CompletedProcess, footer: bool = False) -> list[str]:
+    lines = [line for line in (done.stdout + done.stderr).splitlines() if line.strip()]
+    if footer:
+        lines = [line for line in lines if not line.startswith(SNAKEMAKE_FOOTER)]
+    return lines[-2:]
+
+
+@pytest.mark.parametrize("layout, said", [
+    ({}, "which has no processed/ folder: it holds 1 entry (flights.zip)"),
+    ({"processed/notes.txt": ""}, "no entry of its processed/ is a flight folder (1 entry; "
+                                  "the first, notes.txt: not a flight folder: a file)"),
+])
+def test_an_alfa_dir_that_is_not_alfas_ends_on_what_to_do(tmp_path, layout, said):
+    alfa = tmp_path / "alfa"
+    (alfa / "flights.zip").parent.mkdir()
+    if not layout:
+        (alfa / "flights.zip").write_text("")
+    for path, text in layout.items():
+        (alfa / path).parent.mkdir(parents=True, exist_ok=True)
+        (alfa / path).write_text(text)
+    done = run_workflow(tmp_path / "work", alfa, "-n", ok=False)
+    last = _last_lines(done)
+    assert last[0] == f"ALFA_DIR is {alfa}, {said}." or last[0] == f"ALFA_DIR is {alfa}: {said}."
+    assert last[1].startswith("What to do: set ALFA_DIR to the folder that holds ALFA's "
+                              "processed/"), last
+    assert "Traceback" not in done.stderr
+
+
+def test_a_processed_folder_without_a_flight_that_reads_ends_on_what_to_do(tmp_path):
+    """A folder named and shaped as a flight whose files do not parse: the manifest job
+    fails, and the run's last words before Snakemake's own say so."""
+    name = "carbonZ_2018-07-18-15-53-31_1_engine_failure"
+    flight = tmp_path / "alfa/processed" / name
+    flight.mkdir(parents=True)
+    (flight / f"{name}-mavros-nav_info-roll.csv").write_text("not,a\nflight\n")
+    done = run_workflow(tmp_path / "work", tmp_path / "alfa", target="results/flights.csv",
+                        ok=False)
+    last = _last_lines(done, footer=True)
+    assert last[0].startswith("What to do: set ALFA_DIR to the folder that holds ALFA's "
+                              "processed/"), last
+    assert last[1] == "Details: results/logs/manifest.log", last
+    assert f"ALFA_DIR is {tmp_path / 'alfa'}: no flight under its processed/ can be read" in (
+        done.stderr)
+
+
+def test_a_misspelt_config_key_ends_on_the_key_and_the_keys_allowed(corpus, tmp_path):
+    (tmp_path / "bad.yaml").write_text("scoring:\n  deadine_s: 5.0\n")
+    done = run_workflow(tmp_path, corpus.parent, "-n", "--configfile",
+                        str(REPO / "config/config.yaml"), str(tmp_path / "bad.yaml"), ok=False)
+    assert _last_lines(done) == [
+        f"config: unknown key 'deadine_s' under scoring (in {tmp_path / 'bad.yaml'}). "
+        "Did you mean 'deadline_s'?", "Allowed there: deadline_s, deadlines_s."]
+    assert "$schema" not in done.stderr + done.stdout
+
+
 def test_every_csv_reads_plainly_with_its_documented_header(runs):
     """pandas' and DuckDB's defaults read each CSV with the header docs/outputs.md lists
     (a one-line provenance comment once made pandas see 410 columns)."""

@@ -1,0 +1,109 @@
+"""What the workflow checks before any job runs, ending on one message that says what
+to do: the config against its schema, and the ALFA folder it was pointed at."""
+
+from __future__ import annotations
+
+import difflib
+import sys
+from pathlib import Path
+
+import yaml
+
+from alfa_bench.data.flight import entries, not_a_flight
+
+__all__ = ["alfa_dir_problem", "config_problem", "stop"]
+
+
+def stop(message: str) -> None:
+    """End the run on ``message``, its last lines, without a traceback."""
+    print(f"\n{message}", file=sys.stderr)
+    sys.exit(1)
+
+
+def _found_in(files, path: list) -> str:
+    """Which of the config ``files`` sets the key at ``path`` (the last one wins)."""
+    found = None
+    for f in files:
+        node = yaml.safe_load(Path(f).read_text()) if Path(f).is_file() else None
+        for key in path:
+            node = node.get(key) if isinstance(node, dict) and key in node else None
+            if node is None:
+                break
+        else:
+            found = f
+    return f"in {found}" if found else "given with --config"
+
+
+def config_problem(config: dict, schema_path: str | Path, files) -> str | None:
+    """The first way ``config`` breaks its schema, in words: the key and where it is
+    set (which of the config ``files``), and for an unknown key the keys allowed
+    there, the nearest first; None if it does not."""
+    import jsonschema
+    from jsonschema.exceptions import best_match
+
+    schema = yaml.safe_load(Path(schema_path).read_text())
+    error = best_match(jsonschema.Draft202012Validator(schema).iter_errors(config))
+    if error is None:
+        return None
+    path = list(error.absolute_path)
+    if error.validator == "additionalProperties":
+        allowed = sorted(error.schema.get("properties", {}))
+        key = sorted(set(error.instance) - set(allowed))[0]
+        near = difflib.get_close_matches(key, allowed, n=1)
+        under = ".".join(map(str, path)) or "the top level"
+        return (f"config: unknown key {key!r} under {under} ({_found_in(files, [*path, key])})."
+                + (f" Did you mean {near[0]!r}?" if near else "")
+                + f"\nAllowed there: {', '.join(allowed)}.")
+    name = ".".join(map(str, path)) or "(top level)"
+    message = error.message if len(error.message) < 200 else error.message[:200] + " ..."
+    return f"config {name}: {message} ({_found_in(files, path)})."
+
+
+def _entries(n: int) -> str:
+    return f"{n} entry" if n == 1 else f"{n} entries"
+
+
+def alfa_dir_problem(alfa_dir: Path, source: str) -> str | None:
+    """Why ``alfa_dir`` (set by ``source``: ``ALFA_DIR`` or the config's ``alfa_dir``)
+    cannot be ALFA's folder, and what to do; None if its ``processed/`` holds a
+    flight folder (whether its files read, the manifest job says)."""
+    processed = alfa_dir / "processed"
+    todo = (f"What to do: set {source} to the folder that holds ALFA's processed/ "
+            "(its flights are processed/carbonZ_*), or unset it to download and verify "
+            "the archive.")
+    if not alfa_dir.is_dir():
+        return f"{source} is {alfa_dir}, which does not exist.\n{todo}"
+    if not processed.is_dir():
+        held = sorted(p.name for p in alfa_dir.iterdir())
+        seen = (f"it holds {_entries(len(held))} ({', '.join(held[:5])}"
+                f"{', ...' if len(held) > 5 else ''})" if held else "it is empty")
+        return f"{source} is {alfa_dir}, which has no processed/ folder: {seen}.\n{todo}"
+    found = entries(processed)
+    if not found:
+        return f"{source} is {alfa_dir}, whose processed/ folder is empty.\n{todo}"
+    why = {p.name: not_a_flight(p) for p in found}
+    if all(why.values()):
+        first = next(iter(why))
+        return (f"{source} is {alfa_dir}: no entry of its processed/ is a flight folder "
+                f"({_entries(len(why))}; the first, {first}: {why[first]}).\n{todo}")
+    return None
+
+
+def failure_message(source: str, alfa_dir: Path) -> str | None:
+    """What a failed run's last lines say, from the logs of the jobs that can fail on
+    the data's folder: the download's error, or the manifest's finding no flight that
+    reads under ``alfa_dir`` (set by ``source``); None when neither failed so."""
+    download = Path("results/logs/download_alfa.log")
+    if download.is_file() and "download failed: " in (text := download.read_text()):
+        why = text.split("download failed: ", 1)[1].split("\n", 1)[0]
+        return f"The ALFA download failed: {why}\nDetails: {download}"
+    manifest = Path("results/logs/manifest.log")
+    if manifest.is_file() and "no readable flights under " in (text := manifest.read_text()):
+        first = next((line.split("excluded: ", 1)[1] for line in text.splitlines()
+                      if " excluded: " in line), "no entry is a flight folder")
+        counted = text.split("no readable flights under ", 1)[1].split("\n", 1)[0]
+        return (f"{source} is {alfa_dir}: no flight under its processed/ can be read "
+                f"({counted.split('(', 1)[-1].rstrip(')')}); the first: {first}\n"
+                f"What to do: set {source} to the folder that holds ALFA's processed/, or "
+                f"unset it to download and verify the archive.\nDetails: {manifest}")
+    return None
