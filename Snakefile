@@ -34,6 +34,7 @@ include: "rules/report.smk"
 rule all:
     input:
         rules.tables.output,
+        rules.index_page.output,
         rules.per_flight.output,
         rules.deadline.output,
         rules.leakage.output,

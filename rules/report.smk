@@ -1,3 +1,16 @@
+# docs/index.png: results/index.html as it opens in headless Chromium; an explicit target
+# (it writes a tracked file, and needs Chromium)
+rule index_screenshot:
+    input:
+        "results/index.html",
+    output:
+        "docs/index.png",
+    log:
+        "results/logs/index_screenshot.log",
+    script:
+        "../scripts/index_screenshot.py"
+
+
 # docs/report.png, from the report `snakemake --report results/report.html` writes
 rule report_screenshot:
     input:

@@ -37,6 +37,23 @@ rule tables:
         "../scripts/tables.py"
 
 
+# The page a reader opens first: the headline, the sweep, detections by class
+rule index_page:
+    input:
+        manifest="results/flights.csv",
+        comparison="results/tables/comparison.csv",
+        by_fault="results/tables/by_fault.csv",
+        sweep="results/figures/sweep.png",
+    output:
+        "results/index.html",
+    params:
+        primary=PRIMARY,
+    log:
+        "results/logs/index_page.log",
+    script:
+        "../scripts/index_page.py"
+
+
 # The model fitted again on calibration pools, beside the thresholds alone; an explicit
 # target (`snakemake stability_refit`), never part of `all`: a fit per pool and fold.
 rule stability_refit:

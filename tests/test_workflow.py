@@ -228,6 +228,28 @@ def test_the_html_report_holds_the_figures_and_tables(runs, corpus):
     assert view.images and min(view.images) > 100, view
 
 
+def test_the_results_page_opens_on_the_headline(runs):
+    """results/index.html, in a 1400 x 900 window without a click or a scroll: the best
+    honest run's row with its numbers, the per-class table, and a figure that loads; no
+    page wider than the window, no external asset."""
+    page = runs[0] / "results/index.html"
+    text = page.read_text()
+    assert "http://" not in text and "https://" not in text
+    from alfa_bench.workflow.report_page import open_index
+    from alfa_bench.workflow.viewer import chromium
+    if chromium() is None:
+        pytest.skip("no Chromium (apt-get install chromium): the page was not opened")
+    view = open_index(page, runs[0] / "index.png")
+    comparison = read_table(runs[0] / "results/tables/comparison.csv")
+    best = comparison[(comparison["subset"] == "no_emr") & (comparison["rank"] == 1)].iloc[0]
+    headline, by_class = view.first_rows[:2]
+    assert headline.split("\t")[:3] == [
+        "1", best["method"], f"{best['tp']} of {best['tp'] + best['fn']}"], view
+    assert by_class.split("\t")[:2] == ["1", best["method"]], view
+    assert view.images and min(view.images) > 100 and not view.errors, view
+    assert view.images_in_view == len(view.images) and view.page_width <= 1400, view
+
+
 def test_the_honest_benchmark_outputs(runs):
     """The leakage audit, the deadline curve and the reference rows, on the corpus."""
     out = runs[0] / "results"
@@ -341,7 +363,8 @@ def test_every_results_path_the_docs_name_is_made_by_the_workflow(runs):
              *sorted((REPO / "docs").glob("*.md"))]
     named = {p for f in texts for p in re.findall(r"`(results/[^`]*)`", f.read_text())}
     assert len(named) > 10
-    named -= {"results/injected/processed/"}        # `snakemake injected_csv` writes it
+    named -= {"results/injected/processed/",         # `snakemake injected_csv` writes it
+              "results/tables/stability_refit.{csv,md}"}   # `snakemake stability_refit`
     missing = [p for p in sorted(named) for q in _expand(p)
                if not list(runs[0].glob(q.rstrip("/")))]
     assert not missing, missing

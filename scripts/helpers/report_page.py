@@ -1,4 +1,4 @@
-"""The Snakemake report in a real browser: load it, open an item, screenshot, check.
+"""The Snakemake report and the results page in a real browser: load, screenshot, check.
 
 ``snakemake --report results/report.html`` writes one self-contained page whose
 script draws everything: :func:`open_report` loads it in headless Chromium (driven by
@@ -14,7 +14,7 @@ from pathlib import Path
 
 from .viewer import CHROMIUM_ARGS, chromium
 
-__all__ = ["ReportView", "open_report"]
+__all__ = ["IndexView", "ReportView", "open_index", "open_report"]
 
 
 @dataclass(frozen=True)
@@ -61,3 +61,50 @@ def open_report(html: str | Path, out: str | Path, category: str, item: str, *,
         finally:
             browser.close()
     return ReportView(overview, images, frames, errors)
+
+
+@dataclass(frozen=True)
+class IndexView:
+    """What ``results/index.html`` shows on arrival: ``first_rows``, the text of each
+    table's first data row whose box lies wholly inside the window (none that does
+    not), ``images``, the natural width of each image (0 for one that failed),
+    ``images_in_view``, how many lie wholly inside the window,
+    ``page_width``, the page's scroll width, and ``errors``, its script errors."""
+
+    first_rows: list[str]
+    images: list[int]
+    images_in_view: int
+    page_width: int
+    errors: list[str]
+
+
+def open_index(html: str | Path, out: str | Path, *, size: tuple[int, int] = (1400, 900)
+               ) -> IndexView:
+    """Open the results page ``html`` in a ``size`` window, without a click or a
+    scroll, save a screenshot of the window to ``out`` and return what it shows."""
+    from playwright.sync_api import sync_playwright
+
+    exe = chromium()
+    if exe is None:
+        raise RuntimeError("no Chromium: install Debian's chromium, or set CHROMIUM")
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=exe, headless=True, args=CHROMIUM_ARGS)
+        try:
+            page = browser.new_page(viewport={"width": size[0], "height": size[1]})
+            errors: list[str] = []
+            page.on("pageerror", lambda e: errors.append(str(e)))
+            page.goto(Path(html).resolve().as_uri())
+            page.wait_for_load_state("load")
+            page.screenshot(path=str(out))
+            rows = page.evaluate(
+                f"Array.from(document.querySelectorAll('table')).map(t => t.rows[1])"
+                f".filter(r => r && r.getBoundingClientRect().bottom <= {size[1]} && "
+                f"r.getBoundingClientRect().right <= {size[0]}).map(r => r.innerText)")
+            images = page.evaluate("Array.from(document.images).map(i => i.naturalWidth)")
+            in_view = page.evaluate(
+                f"Array.from(document.images).filter(i => i.getBoundingClientRect().bottom "
+                f"<= {size[1]} && i.getBoundingClientRect().right <= {size[0]}).length")
+            width = page.evaluate("document.documentElement.scrollWidth")
+        finally:
+            browser.close()
+    return IndexView(rows, images, in_view, width, errors)

@@ -1,0 +1,106 @@
+"""The page a reader opens first: ``results/index.html``.
+
+One light page, no external assets (the figure is inlined), that shows on arrival what
+the run found: the ranked honest runs on the headline subset, with their detections
+in time beside the stable ones and false alarms on fault-free flights; the threshold
+sweep figure; and each of those runs' detections by fault class. It links to the full
+tables, the per-flight outcomes and the Snakemake report.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+from pathlib import Path
+
+import pandas as pd
+
+from .render import fmt
+from .tables import FAULT_ORDER, SUBSET_NOTES
+
+__all__ = ["index_html"]
+
+#: laid out to show the headline, the per-class table and the figure in a 1400 x 900
+#: window without a scroll
+_STYLE = """
+body { font: 14px/1.35 system-ui, sans-serif; margin: 14px 28px; color: #222;
+       max-width: 1340px; }
+h1 { font-size: 19px; margin: 0 0 2px; } h2 { font-size: 15px; margin: 10px 0 4px; }
+p { margin: 2px 0 6px; } table { border-collapse: collapse; font-size: 13px; }
+th, td { padding: 1px 8px; border-bottom: 1px solid #ddd; text-align: right; }
+th { background: #f3f3f3; } td:nth-child(2), th:nth-child(2) { text-align: left; }
+.row { display: flex; gap: 28px; align-items: flex-start; }
+img { max-height: 330px; max-width: 100%; border: 1px solid #eee; }
+.links a { margin-right: 14px; } .note { color: #555; font-size: 12px; }
+"""
+
+#: the runs the per-class table shows, best first (every run: comparison.md)
+CLASS_ROWS = 8
+
+
+def _row(cells: list[str], tag: str = "td") -> str:
+    return "<tr>" + "".join(f"<{tag}>{html.escape(c)}</{tag}>" for c in cells) + "</tr>"
+
+
+def index_html(comparison: pd.DataFrame, by_fault: pd.DataFrame, sweep_png: Path,
+               primary: str, run: str) -> str:
+    """The page (module docstring) from the run's ``comparison`` and ``by_fault``
+    tables and its sweep figure; ``run`` names the run in the footer."""
+    table = comparison[(comparison["subset"] == primary) & comparison["rank"].notna()]
+    table = table.sort_values("rank")
+    d = fmt(float(comparison["deadline_s"].iloc[0]), digits=1)
+    flights = int(table["flights"].iloc[0]) if len(table) else 0
+    head = ["rank", "method", f"faults detected ≤{d} s", "of them stable",
+            "over calibration pools", "fault-free flights alarmed", "precision %",
+            "recall %", "accuracy %", "mean det. s", "rank over pools"]
+    rows = [_row(head, "th")]
+    for r in table.to_dict(orient="records"):
+        stable = r.get("stable_detections")
+        pooled = fmt(stable) != "-"
+        rows.append(_row([
+            str(int(r["rank"])), r["method"], f"{int(r['tp'])} of {int(r['tp'] + r['fn'])}",
+            str(int(stable)) if pooled else "no pools",
+            (f"{fmt(r['detections_low'], digits=0)}-{fmt(r['detections_high'], digits=0)}"
+             if pooled else "-"),
+            f"{int(r['fault_free_false_alarms'])} of {int(r['fault_free_flights'])}",
+            fmt(r["precision"], True, 1), fmt(r["recall"], True, 1),
+            fmt(r["accuracy"], True, 1), fmt(r["mean_detection_s"]),
+            str(r.get("rank_range") or "-")]))
+    classes = [c for c in FAULT_ORDER if c != "none"]
+    per_class = by_fault[(by_fault["subset"] == primary)
+                         & by_fault["method"].isin(table["method"])]
+    counts = {(r["method"], r["fault_class"]): f"{r['detected']} of {r['flights']}"
+              for r in per_class.to_dict(orient="records")}
+    present = [c for c in classes if any(k[1] == c for k in counts)]
+    class_rows = [_row(["rank", "method", *present], "th")] + [
+        _row([str(int(r["rank"])), r["method"], *(counts.get((r["method"], c), "-")
+                                                  for c in present)])
+        for r in table.head(CLASS_ROWS).to_dict(orient="records")]
+    figure = base64.b64encode(Path(sweep_png).read_bytes()).decode()
+    note = f"; {html.escape(SUBSET_NOTES[primary])}" if primary in SUBSET_NOTES else ""
+    return f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>alfa-bench: results</title>
+<style>{_STYLE}</style></head><body>
+<h1>alfa-bench: online fault detectors on the ALFA flights</h1>
+<p>Headline: subset <code>{html.escape(primary)}</code> ({flights} flights{note}).
+A fault counts as detected when the first alarm comes at most {d} s after its onset.
+Only honest runs (sensors and setpoints only) are ranked. A detection is <em>stable</em>
+when it survives at least the configured share of resampled calibration pools.</p>
+<p class="links"><a href="tables/comparison.html">every run and subset</a>
+<a href="tables/stability.md">stability</a> <a href="tables/per_flight.md">per flight</a>
+<a href="../paper/build/paper.md">the paper</a> <a href="report.html">the Snakemake report</a></p>
+<h2>Ranked honest runs, deadline {d} s</h2>
+<table>{''.join(rows)}</table>
+<div class="row"><div>
+<h2>Faults detected in time, by class (the best {CLASS_ROWS})</h2>
+<table>{''.join(class_rows)}</table></div>
+<div><h2>Threshold sweep</h2>
+<a href="figures/sweep.png"><img alt="Threshold sweep of every method"
+     src="data:image/png;base64,{figure}"></a>
+<p class="note">Every channel threshold of a method scaled by one factor and the stored
+scores re-scored, on <code>{html.escape(primary)}</code> with the deadline; dots mark
+the configured thresholds.</p></div></div>
+<p class="note">Run {html.escape(run)}: code, packages, config, data and checksums in
+<code>results/provenance.json</code>.</p>
+</body></html>
+"""

@@ -1,0 +1,15 @@
+"""Snakemake script: results/index.html, the page a reader opens first."""
+
+from pathlib import Path
+
+from alfa_bench.data import read_manifest
+from alfa_bench.outputs.index_page import index_html
+from alfa_bench.outputs.provenance import read_table, run_id, run_provenance
+from alfa_bench.workflow.logs import log_to
+
+sm = snakemake  # noqa: F821
+log_to(sm.log[0])
+prov = run_provenance(sm.config, read_manifest(sm.input.manifest))
+Path(sm.output[0]).write_text(index_html(
+    read_table(sm.input.comparison), read_table(sm.input.by_fault), Path(sm.input.sweep),
+    sm.params.primary, run_id(prov)))
