@@ -214,6 +214,11 @@ class Result:
         return Path(path)
 
 
+def _stable(config: dict) -> tuple[float, float]:
+    """The config's survival for a stable detection, and its pool interval."""
+    return config["stability"]["stable"], config["stability"]["interval"]
+
+
 def _subsets(config: dict) -> list[str]:
     primary = config["primary_subset"]
     return [primary, *(s for s in config["subsets"] if s != primary)]
@@ -273,7 +278,8 @@ def evaluate(detector: Detector | str, corpus: Corpus, *, name: str | None = Non
                               [pd.DataFrame(failed, columns=FAILURE_COLUMNS)])
     per_flight = per_flight_table(records, {(name, f): t for f, t in traces.items()},
                                   manifest, deadline_s)
-    summary = comparison_table(records, manifest, subsets, deadline_s, failures)
+    summary = comparison_table(records, manifest, subsets, deadline_s, failures,
+                               *_stable(config))
     return Result(name, records, traces, per_flight, summary, failures, extra, corpus,
                   detector, subsets, deadline_s)
 
@@ -323,7 +329,8 @@ def compare(*results: Result, published: str | os.PathLike | None = "results"
     if len(set(names)) != len(names):
         raise ValueError(f"two results share a name: {names}")
     return comparison_table(records, manifest, first.subsets, first.deadline_s,
-                            pd.concat(failures, ignore_index=True).drop_duplicates())
+                            pd.concat(failures, ignore_index=True).drop_duplicates(),
+                            *_stable(first.corpus.config))
 
 
 def _check_same_flights(manifest: pd.DataFrame, results, out: Path) -> None:

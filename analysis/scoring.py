@@ -26,8 +26,8 @@ import math
 from collections.abc import Sequence
 from fractions import Fraction
 
-__all__ = ["OUTCOMES", "flight_outcome", "mcnemar_exact", "score_records", "summarize",
-           "wilson_interval"]
+__all__ = ["OUTCOMES", "flight_outcome", "mcnemar_exact", "rates", "score_records",
+           "summarize", "wilson_interval"]
 
 OUTCOMES = ("TP", "FP", "FN", "TN", "FP+FN")
 
@@ -92,6 +92,23 @@ def _ratio(a: int, b: int) -> float:
     return a / b if b else math.nan
 
 
+def rates(outcomes: Sequence[str], detection_s: Sequence[float | None] = ()) -> dict:
+    """:func:`summarize` without the intervals: the counts, precision, recall, accuracy
+    and the detection times (cheap enough to score the calibration pools with)."""
+    bad = set(outcomes) - set(OUTCOMES)
+    if bad:
+        raise ValueError(f"unknown outcomes {sorted(bad)}")
+    n = {o: sum(1 for x in outcomes if x == o) for o in OUTCOMES}
+    tp, tn = n["TP"], n["TN"]
+    fp, fn = n["FP"] + n["FP+FN"], n["FN"] + n["FP+FN"]
+    times = [d for d in detection_s if d is not None]
+    return {"flights": len(outcomes), "tp": tp, "fp": fp, "fn": fn, "tn": tn,
+            "precision": _ratio(tp, tp + fp), "recall": _ratio(tp, tp + fn),
+            "accuracy": _ratio(tp + tn, len(outcomes)),
+            "mean_detection_s": sum(times) / len(times) if times else math.nan,
+            "max_detection_s": max(times) if times else math.nan}
+
+
 def summarize(outcomes: Sequence[str], detection_s: Sequence[float | None] = ()) -> dict:
     """Counts and rates over flights.
 
@@ -109,24 +126,15 @@ def summarize(outcomes: Sequence[str], detection_s: Sequence[float | None] = ())
         with its Wilson 95 % interval (``<rate>_low``, ``<rate>_high``),
         mean_detection_s, max_detection_s (NaN without true positives).
     """
-    bad = set(outcomes) - set(OUTCOMES)
-    if bad:
-        raise ValueError(f"unknown outcomes {sorted(bad)}")
-    n = {o: sum(1 for x in outcomes if x == o) for o in OUTCOMES}
-    tp, tn = n["TP"], n["TN"]
-    fp, fn = n["FP"] + n["FP+FN"], n["FN"] + n["FP+FN"]
-    times = [d for d in detection_s if d is not None]
-    rates = {"precision": (tp, tp + fp), "recall": (tp, tp + fn),
-             "accuracy": (tp + tn, len(outcomes))}
-    out = {"flights": len(outcomes), "tp": tp, "fp": fp, "fn": fn, "tn": tn}
-    for name, (k, n_) in rates.items():
-        out[name] = _ratio(k, n_)
-        out[f"{name}_low"], out[f"{name}_high"] = wilson_interval(k, n_)
-    return {
-        **out,
-        "mean_detection_s": sum(times) / len(times) if times else math.nan,
-        "max_detection_s": max(times) if times else math.nan,
-    }
+    r = rates(outcomes, detection_s)
+    tp, fp, fn, tn = r["tp"], r["fp"], r["fn"], r["tn"]
+    out = {k: r[k] for k in ("flights", "tp", "fp", "fn", "tn")}
+    for name, (k, n) in {"precision": (tp, tp + fp), "recall": (tp, tp + fn),
+                         "accuracy": (tp + tn, r["flights"])}.items():
+        out[name] = r[name]
+        out[f"{name}_low"], out[f"{name}_high"] = wilson_interval(k, n)
+    return {**out, "mean_detection_s": r["mean_detection_s"],
+            "max_detection_s": r["max_detection_s"]}
 
 
 def score_records(records: Sequence[dict], deadline_s: float = math.inf) -> tuple[list[str], dict]:

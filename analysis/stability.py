@@ -37,10 +37,10 @@ import pandas as pd
 from alfa_bench.data import subset_flights
 from alfa_bench.methods import Trace
 
-from .scoring import flight_outcome
+from .scoring import flight_outcome, rates
 
 __all__ = ["calibration_table", "pool_counts", "pool_draws", "pool_first_alarms",
-           "pool_outcomes", "pool_rank_keys", "refit_first_alarms", "refit_table",
+           "pool_outcomes", "pool_summaries", "refit_first_alarms", "refit_table",
            "stability_table", "survival"]
 
 log = logging.getLogger(__name__)
@@ -100,30 +100,19 @@ def pool_counts(recs: list[dict], deadline_s: float) -> tuple[np.ndarray, np.nda
     return tp, fa
 
 
-def pool_rank_keys(recs: list[dict], deadline_s: float, pools: int) -> list[tuple]:
-    """Per pool, what the comparison ranks ``recs``' run by: accuracy, recall (both
-    negated, higher first) and mean detection time; the reported ones for every pool
-    where the run has no pools."""
-    table = [pool_outcomes(r, deadline_s) for r in recs]
-    keys = []
+def pool_summaries(recs: list[dict], deadline_s: float, pools: int) -> list[dict]:
+    """Per pool, the :func:`~.scoring.rates` of ``recs`` under that pool's first alarms
+    (the reported ones for every pool where the run has no pools): what the comparison
+    ranks a run by, pool by pool."""
+    out = []
     for b in range(pools):
-        outcomes, firsts = [], []
-        for r, o in zip(recs, table, strict=True):
-            if o is None:
-                first = r["first_alarm_s"]
-                outcomes.append(flight_outcome(r["onset_s"], first, deadline_s))
-            else:
-                first = r["stability"]["first_alarm_s"][b]
-                outcomes.append(o[b])
-            firsts.append(first)
-        tp = outcomes.count("TP")
-        fn = sum(o in ("FN", "FP+FN") for o in outcomes)
-        delays = [f - r["onset_s"] for r, o, f in zip(recs, outcomes, firsts, strict=True)
-                  if o == "TP"]
-        keys.append((-(tp + outcomes.count("TN")) / len(outcomes),
-                     -(tp / (tp + fn)) if tp + fn else math.inf,
-                     sum(delays) / len(delays) if delays else math.inf))
-    return keys
+        firsts = [r["stability"]["first_alarm_s"][b] if r.get("stability")
+                  else r["first_alarm_s"] for r in recs]
+        outcomes = [flight_outcome(r["onset_s"], f, deadline_s)
+                    for r, f in zip(recs, firsts, strict=True)]
+        out.append(rates(outcomes, [f - r["onset_s"] if o == "TP" else None
+                                    for r, f, o in zip(recs, firsts, outcomes, strict=True)]))
+    return out
 
 
 def stability_table(records: list[dict], manifest: pd.DataFrame, subsets, deadline_s: float,

@@ -34,7 +34,7 @@ import pandas as pd
 from alfa_bench.analysis.isolation import names_class
 from alfa_bench.analysis.reference import ICRA2019_BY_FAULT, ICRA2019_NAME, ICRA2019_SUMMARY
 from alfa_bench.analysis.scoring import mcnemar_exact, score_records
-from alfa_bench.analysis.stability import pool_rank_keys, stability_table
+from alfa_bench.analysis.stability import pool_summaries, stability_table
 from alfa_bench.data import FAILURE_COLUMNS, FAULT_CLASSES, subset_flights
 
 from .render import Section, fmt, latex_tables, markdown
@@ -198,8 +198,7 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
                    for k in ("stable_detections", "detections_low", "detections_high")},
             }, recs))
         honest = sorted((r[:2] for r in runs if r[1]["block"] == "honest"),
-                        key=lambda r: (-_num(r[1]["accuracy"]), -_num(r[1]["recall"]),
-                                       _num(r[1]["mean_detection_s"], math.inf)))
+                        key=lambda r: _rank_key(r[1]))
         common = set().union(*(set(c) for c, _ in honest))
         recs_of = {row["method"]: recs for _, row, recs in runs}
         runs = [r[:2] for r in runs]
@@ -237,7 +236,8 @@ def _rank_ranges(ranked: list[dict], recs_of: dict[str, list[dict]], deadline_s:
         row["rank_range"] = str(row["rank"])
     if not pools:
         return
-    keys = [pool_rank_keys(recs_of[row["method"]], deadline_s, pools) for row in ranked]
+    keys = [[_rank_key(s) for s in pool_summaries(recs_of[row["method"]], deadline_s, pools)]
+            for row in ranked]
     seen = [[] for _ in ranked]
     for b in range(pools):
         # ties keep the reported order, as the reported ranking does
@@ -246,6 +246,13 @@ def _rank_ranges(ranked: list[dict], recs_of: dict[str, list[dict]], deadline_s:
     for row, places in zip(ranked, seen, strict=True):
         low, high = min(places), max(places)
         row["rank_range"] = str(low) if low == high else f"{low}-{high}"
+
+
+def _rank_key(scores: dict) -> tuple[float, float, float]:
+    """What honest runs are ranked by: accuracy, then recall (higher first), then mean
+    detection time (lower first)."""
+    return (-_num(scores["accuracy"]), -_num(scores["recall"]),
+            _num(scores["mean_detection_s"], math.inf))
 
 
 def _num(v, nan=-math.inf) -> float:
