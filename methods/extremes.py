@@ -10,10 +10,10 @@ flight moves it little (:func:`gumbel_threshold`), and
 
 .. math::
 
-    \gamma_c = F^{-1}_{\mathrm{Gumbel}}(1 - lpha / C;\ \hat\mu_c, \hateta_c)
+    \gamma_c = F^{-1}_{\mathrm{Gumbel}}(1 - \alpha / C;\ \hat\mu_c, \hat\beta_c)
 
 so that a fault-free flight like the training ones alarms on any channel with
-probability about :math:`lpha` (Bonferroni).
+probability about :math:`\alpha` (Bonferroni).
 """
 
 from __future__ import annotations
@@ -134,6 +134,8 @@ class MaximaThresholds:
         Per channel, :math:`M_{c,j}` over the training segments.
     gamma_ : dict of str to float
         Per channel, :math:`\gamma_c`.
+    maxima_flights_ : dict of str to list of str
+        Per channel, the flight of each of ``maxima_`` (:meth:`pool_thresholds`).
     """
 
     calibrated = True
