@@ -7,6 +7,7 @@ from snakemake.exceptions import WorkflowError
 
 from alfa_bench.workflow.checks import alfa_dir_problem, failure_message, stop
 from alfa_bench.workflow.dependencies import module_sources
+from alfa_bench.workflow.resources import count_flights, job_resources
 from alfa_bench.outputs.provenance import RUN_FILE
 from alfa_bench.data import SIGNALS, resolve_alfa_dir
 from alfa_bench.methods import REGISTRY, make_detector
@@ -75,6 +76,8 @@ if _alfa is not None and (_why := alfa_dir_problem(_alfa, ALFA_SOURCE)):
 DOWNLOAD = _alfa is None
 ALFA_DIR = Path(config["download"]["dest"]) if DOWNLOAD else _alfa
 PROCESSED = ALFA_DIR / "processed"
+# every rule's mem_mb and runtime, for a scheduler to place its jobs (profiles/slurm)
+JOB_RESOURCES = job_resources(count_flights(PROCESSED))
 # where the flights came from, in every result's provenance (config is what it records)
 config["alfa_dir"] = str(ALFA_DIR)
 config["data_origin"] = (

@@ -12,6 +12,8 @@ if DOWNLOAD:
             directory(PROCESSED),
         params:
             download=config["download"],
+        resources:
+            **JOB_RESOURCES,
         log:
             "results/logs/download_alfa.log",
         script:
@@ -28,6 +30,8 @@ rule manifest:
         cache=directory("results/cache"),
     params:
         strict=config["strict"],
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/manifest.log",
     benchmark:

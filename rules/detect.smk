@@ -21,6 +21,8 @@ rule detect_reference:
         calibration=config["calibration"],
         stability=config["stability"],
         strict=config["strict"],
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/detect/{method}.log",
     benchmark:

@@ -13,6 +13,8 @@ rule inject:
     params:
         injection=config["injection"],
         processed=INJECTED_PROCESSED,
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/inject.log",
     benchmark:
@@ -31,6 +33,8 @@ rule injected_csv:
         processed=directory(INJECTED_PROCESSED),
     params:
         injection=config["injection"],
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/injected_csv.log",
     script:
@@ -51,6 +55,8 @@ rule detectability:
                       caption="../report/detectability.rst", category="Sensor faults"),
     params:
         methods=DETECTORS,
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/detectability.log",
     benchmark:
@@ -75,6 +81,8 @@ rule isolation:
                             caption="../report/isolation_actuators.rst", category="Comparison"),
     params:
         methods=DETECTORS,
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/isolation.log",
     benchmark:

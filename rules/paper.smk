@@ -35,6 +35,8 @@ rule paper_sources:
         macros="paper/build/results.tex",
         markdown=report("paper/build/paper.md", caption="../report/paper.rst",
                         category="Manuscript"),
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/paper_sources.log",
     benchmark:
@@ -50,6 +52,8 @@ rule paper_pdf:
         tex=PAPER_DIR / "paper.tex",
     output:
         "paper/build/paper.pdf",
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/paper_pdf.log",
     shell:

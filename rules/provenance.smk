@@ -12,6 +12,8 @@ rule provenance:
     params:
         # differ between runs by nature: rerun's clock-drawn ids, measured times
         unchecked=["results/rerun/*.rrd", "results/runtime/*"],
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/provenance.log",
     benchmark:

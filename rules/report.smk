@@ -5,6 +5,8 @@ rule index_screenshot:
         "results/index.html",
     output:
         "docs/index.png",
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/index_screenshot.log",
     script:
@@ -17,6 +19,8 @@ rule report_screenshot:
         "results/report.html",
     output:
         "docs/report.png",
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/report_screenshot.log",
     script:

@@ -11,6 +11,8 @@ rule rerun_logs:
     params:
         # canonical JSON: reordered keys are not a change (the tab order follows input)
         methods=json.dumps(config["methods"], sort_keys=True),
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/rerun_logs.log",
     benchmark:
@@ -29,6 +31,8 @@ rule viewer_screenshot:
         "docs/viewer.png",
     params:
         flight=config["figures"].get("viewer_flight", ""),
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/viewer_screenshot.log",
     script:

@@ -14,6 +14,8 @@ rule sweep:
         subsets=SUBSETS,
         deadline_s=config["scoring"]["deadline_s"],
         subset=PRIMARY,
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/sweep.log",
     benchmark:
@@ -32,6 +34,8 @@ rule flight_figures:
         report(directory("results/figures/flights"), patterns=["{flight}.png"],
                caption="../report/flight.rst", category="Flights",
                subcategory=figure_fault_class),
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/flight_figures.log",
     benchmark:
@@ -47,6 +51,8 @@ rule readme_figure:
         "results/figures/sweep.png",
     output:
         "paper/figures/sweep.png",
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/readme_figure.log",
     shell:

@@ -29,6 +29,8 @@ rule tables:
         primary=PRIMARY,
         deadline_s=config["scoring"]["deadline_s"],
         stability=config["stability"],
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/tables.log",
     benchmark:
@@ -48,6 +50,8 @@ rule index_page:
         "results/index.html",
     params:
         primary=PRIMARY,
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/index_page.log",
     script:
@@ -71,6 +75,8 @@ rule stability_refit:
         stability=config["stability"],
         subsets=SUBSETS,
         deadline_s=config["scoring"]["deadline_s"],
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/stability_refit.log",
     script:
@@ -89,6 +95,8 @@ rule per_flight:
         records="results/tables/detections.parquet",
     params:
         deadline_s=config["scoring"]["deadline_s"],
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/per_flight.log",
     benchmark:
@@ -108,6 +116,8 @@ rule runtime:
         md="results/runtime/runtime.md",
         html=report("results/runtime/runtime.html", caption="../report/runtime.rst",
                     category="Runtime"),
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/runtime.log",
     benchmark:
@@ -134,6 +144,8 @@ rule deadline:
         deadlines_s=config["scoring"]["deadlines_s"],
         deadline_s=config["scoring"]["deadline_s"],
         subset=PRIMARY,
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/deadline.log",
     benchmark:
@@ -152,6 +164,8 @@ rule leakage:
         md="results/tables/leakage.md",
         html=report("results/tables/leakage.html", caption="../report/leakage.rst",
                     category="Leakage audit"),
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/leakage.log",
     benchmark:
@@ -174,6 +188,8 @@ rule ceiling:
         subsets=SUBSETS,
         deadline_s=config["scoring"]["deadline_s"],
         margin_s=config["calibration"]["margin_s"],
+    resources:
+        **JOB_RESOURCES,
     log:
         "results/logs/ceiling.log",
     benchmark:
