@@ -1,9 +1,16 @@
+import hashlib
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
+import yaml
 
 sys.path.insert(0, str(Path(__file__).parent))
+
+from loopback import make_archive, serve_archive  # noqa: E402
+from slurm_cluster import slurm_profile, slurm_unavailable, through_slurm  # noqa: E402
+from workflow_runs import GRID, REPO, run_workflow  # noqa: E402
 
 from alfa_bench.data import build_manifest, load_flight, resolve_alfa_dir  # noqa: E402
 from alfa_bench.data.synthetic import write_corpus, write_flight  # noqa: E402
@@ -51,3 +58,53 @@ def one_flight(tmp_path) -> Path:
     """A writable synthetic engine-failure flight folder."""
     return write_flight(tmp_path / "processed", "carbonZ_2018-07-18-15-53-31_1_engine_failure",
                         onset_s=50.0)
+
+
+@pytest.fixture(scope="session")
+def overlay(corpus, tmp_path_factory):
+    """The workflow runs' own config: the small grid, and the corpus served as ALFA's
+    archive from a loopback stand-in for KiltHub (its port fixed, so runs share a config)."""
+    archive = make_archive(corpus)
+    with serve_archive(archive) as (api, requests):
+        path = tmp_path_factory.mktemp("overlay") / "overlay.yaml"
+        path.write_text(yaml.safe_dump({"injection": GRID, "download": {
+            "api": api, "file": "processed.zip", "md5": hashlib.md5(archive).hexdigest(),
+            "sha256": None, "dest": "resources/alfa"}}))
+        yield path, requests
+
+
+@pytest.fixture(scope="session")
+def slurm_run(overlay, tmp_path_factory):
+    """The README's first command through a real one-node SLURM cluster
+    (tests/slurm_cluster.py) with the project's SLURM profile, one detect job killed
+    once while it runs; None where no cluster can be brought up (slurm_unavailable)."""
+    if slurm_unavailable():
+        return None
+    root = tmp_path_factory.mktemp("slurm")
+    work = root / "run"
+    profile = slurm_profile(REPO / "profiles/slurm", root / "profile")
+    config, _ = overlay
+    return through_slurm(root / "cluster", work, "rule_detect_wildcards_", lambda env: run_workflow(
+        work, None, "--configfile", str(REPO / "config/config.yaml"), str(config),
+        "--profile", str(profile), ok=None, quiet=False, env=env))
+
+
+@pytest.fixture(scope="session")
+def runs(overlay, slurm_run):
+    """Two runs of the README's first command, each downloading the archive: the
+    reference that the workflow tests read and that other ways of running it match.
+    The second is the run through SLURM where it succeeded (its results must be the
+    first's all the same), else a second local run."""
+    config, requests = overlay
+    dirs = [Path(tempfile.mkdtemp(prefix="run0", dir=config.parent))]
+    if slurm_run is not None and slurm_run.done.returncode == 0:
+        dirs.append(slurm_run.workdir)
+    else:
+        dirs.append(Path(tempfile.mkdtemp(prefix="run1", dir=config.parent)))
+    for d in dirs:
+        if not (d / "results").exists():
+            before = requests.count("/file/1")
+            run_workflow(d, None, "--configfile", str(REPO / "config/config.yaml"),
+                         str(config))
+            assert requests.count("/file/1") == before + 1
+    return dirs

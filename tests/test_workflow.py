@@ -1,20 +1,16 @@
 """`snakemake all` end to end on a synthetic corpus: outputs, contents, reproducibility."""
 
-import hashlib
 import json
 import os
 import re
 import shutil
 import subprocess
-import sys
-import tempfile
 from pathlib import Path
 
 import pytest
 import yaml
 from broken import GT, IMU, ROLL, _gap, _late_start, edit, set_cell, shift_time
-from loopback import make_archive, serve_archive
-from recordings import content
+from workflow_runs import GRID, REPO, SNAKEMAKE, assert_same_results, run_workflow
 
 from alfa_bench.analysis.detections import (
     INJECTED_RECORDS,
@@ -29,55 +25,6 @@ from alfa_bench.outputs.provenance import RUN_FILE, read_provenance, read_table
 
 # Snakemake or pip in a subprocess, minutes in all: `pytest -m "not workflow"` skips them
 pytestmark = pytest.mark.workflow
-
-REPO = Path(__file__).resolve().parent.parent
-SNAKEMAKE = [sys.executable, "-m", "snakemake"]
-
-
-def run_workflow(workdir: Path, alfa_dir: Path | None, *args: str, target: str = "all",
-                 ok: bool = True) -> subprocess.CompletedProcess:
-    """Run the workflow in ``workdir``; ``alfa_dir=None`` runs it as the README's first
-    command does, without ALFA_DIR, so that it downloads the archive."""
-    env = {k: v for k, v in os.environ.items() if k != "ALFA_DIR"}
-    if alfa_dir is not None:
-        env["ALFA_DIR"] = str(alfa_dir)
-    cmd = [*SNAKEMAKE, target, "--cores", "2", "--snakefile", str(REPO / "Snakefile"),
-           "--directory", str(workdir), "--configfile", str(REPO / "config/config.yaml"),
-           "--quiet", *args]
-    done = subprocess.run(cmd, env=env, capture_output=True, text=True)
-    assert (done.returncode == 0) == ok, done.stdout + done.stderr
-    return done
-
-
-#: a small injected grid for the tests (config/config.yaml's is for the real flights)
-GRID = {"sensors": ["roll", "airspeed", "pitch_rate"],
-        "faults": [{"kind": "drift", "magnitude": 0.5}, {"kind": "scale", "magnitude": 0.9},
-                   {"kind": "stuck", "magnitude": 0.0}],
-        "onsets": [0.5]}
-
-
-@pytest.fixture(scope="module")
-def overlay(corpus, tmp_path_factory):
-    """The runs' own config: the small grid, and the corpus served as ALFA's archive
-    from a loopback stand-in for KiltHub (its port fixed, so both runs share a config)."""
-    archive = make_archive(corpus)
-    with serve_archive(archive) as (api, requests):
-        path = tmp_path_factory.mktemp("overlay") / "overlay.yaml"
-        path.write_text(yaml.safe_dump({"injection": GRID, "download": {
-            "api": api, "file": "processed.zip", "md5": hashlib.md5(archive).hexdigest(),
-            "sha256": None, "dest": "resources/alfa"}}))
-        yield path, requests
-
-
-@pytest.fixture(scope="module")
-def runs(overlay):
-    """Two runs of the README's first command, each downloading the archive."""
-    config, requests = overlay
-    dirs = [Path(tempfile.mkdtemp(prefix=f"run{i}", dir=config.parent)) for i in range(2)]
-    for d in dirs:
-        run_workflow(d, None, "--configfile", str(REPO / "config/config.yaml"), str(config))
-    assert requests.count("/file/1") == 2
-    return dirs
 
 
 def test_outputs_and_their_contents(runs, corpus):
@@ -371,21 +318,8 @@ def test_every_results_path_the_docs_name_is_made_by_the_workflow(runs):
 
 
 def test_two_runs_are_byte_identical(runs):
-    """Every result is byte-identical between runs, but the rerun recordings: rerun 0.41
-    draws its ids from the clock and orders its footer index by a hash map (docs/viewer.md),
-    so their entities, times and values are compared."""
-    a, b = runs
-    skip = {"logs", "benchmarks", "runtime"}                 # times vary between runs
-    files = sorted(p.relative_to(a) for p in (a / "results").rglob("*")
-                   if p.is_file() and not skip & set(p.parts))
-    files += sorted(p.relative_to(a) for p in (a / "paper/build").glob("*")
-                    if p.suffix in {".md", ".tex", ".pdf"})
-    assert len(files) > 50
-    for rel in files:
-        if rel.suffix == ".rrd":
-            assert content(a / rel) == content(b / rel), rel
-        else:
-            assert (a / rel).read_bytes() == (b / rel).read_bytes(), rel
+    """Every result is byte-identical between runs (the recordings' content is)."""
+    assert assert_same_results(*runs) > 50
 
 
 @pytest.fixture(scope="module")
