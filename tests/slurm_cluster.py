@@ -7,6 +7,7 @@ configuration is ``tests/slurm/slurm.conf`` and ``tests/slurm/slurmdbd.conf``.
 """
 
 import csv
+import getpass
 import importlib.util
 import os
 import shutil
@@ -94,9 +95,9 @@ def slurm_cluster(root: Path):
     procs: list[subprocess.Popen] = []
 
     def start(*cmd, name: str) -> None:
-        out = open(log / f"{name}.out", "w")
-        procs.append(subprocess.Popen(cmd, env=env, stdout=out, stderr=subprocess.STDOUT,
-                                      start_new_session=True))
+        with open(log / f"{name}.out", "w") as out:
+            procs.append(subprocess.Popen(cmd, env=env, stdout=out,
+                                          stderr=subprocess.STDOUT, start_new_session=True))
 
     sock = root / "munge/munge.socket"
     db_sock = root / "db.sock"
@@ -122,12 +123,12 @@ def slurm_cluster(root: Path):
         subprocess.run([_program("mariadb"), "--no-defaults", f"--socket={db_sock}",
                         "-u", "root", "-e", sql], env=env, capture_output=True, check=True)
 
-        start(_program("slurmdbd"), "-D", name="slurmdbd")  # reads slurmdbd.conf beside SLURM_CONF
+        # slurmdbd takes no -f: it reads slurmdbd.conf beside SLURM_CONF
+        start(_program("slurmdbd"), "-D", name="slurmdbd")
         _wait("slurmdbd", lambda: _succeeds("sacctmgr", "-n", "list", "cluster", env=env),
               log / "slurmdbd.log")
-        user = os.environ.get("USER") or _user()
         for args in (("cluster", "alfa-test"), ("account", ACCOUNT, "cluster=alfa-test"),
-                     ("user", user, f"account={ACCOUNT}", "cluster=alfa-test")):
+                     ("user", getpass.getuser(), f"account={ACCOUNT}", "cluster=alfa-test")):
             subprocess.run(["sacctmgr", "-i", "add", *args], env=env, capture_output=True,
                            check=True)
 
@@ -138,7 +139,8 @@ def slurm_cluster(root: Path):
         _wait("slurmd", lambda: _idle(env), log / "slurmd.log")
         yield env
     finally:
-        subprocess.run(["scancel", "--user", _user()], env=env, capture_output=True)
+        subprocess.run(["scancel", "--user", getpass.getuser()], env=env,
+                       capture_output=True)
         for proc in reversed(procs):      # slurmd first, munged last
             proc.terminate()
             try:
@@ -245,16 +247,20 @@ def _step_shim(root: Path, conf: Path) -> str:
 
 
 def running(root: Path) -> list[str]:
-    """The cluster's processes still alive: a daemon started on ``root``'s
-    configuration, or any job step (``slurmstepd``)."""
+    """The command lines of the cluster's processes still alive: those whose command
+    line or environment names ``root`` (every daemon was started with ``SLURM_CONF``
+    there, and job steps and scripts inherit it), and any ``slurmstepd``."""
     alive = []
     for proc in Path("/proc").glob("[0-9]*"):
         try:
             cmd = (proc / "cmdline").read_bytes().replace(b"\0", b" ").decode().strip()
+            environ = (proc / "environ").read_bytes()
         except OSError:
             continue
-        name = Path(cmd.split(" ")[0]).name if cmd else ""
-        if (name in DAEMONS and str(root) in cmd) or name.startswith("slurmstepd"):
+        if not cmd or proc.name == str(os.getpid()):
+            continue
+        if (str(root) in cmd or str(root).encode() in environ
+                or cmd.startswith("slurmstepd")):
             alive.append(cmd)
     return alive
 
@@ -263,11 +269,6 @@ def _idle(env: dict) -> bool:
     done = subprocess.run(["sinfo", "-h", "-o", "%t"], env=env, capture_output=True,
                           text=True)
     return done.returncode == 0 and done.stdout.strip() == "idle"
-
-
-def _user() -> str:
-    import pwd
-    return pwd.getpwuid(os.getuid()).pw_name
 
 
 def _memory_mb() -> int:
