@@ -72,15 +72,23 @@ def test_the_plugin_checks_itself_with_parametrize_with_checks(installed, tmp_pa
 
 
 @pytest.mark.workflow
-def test_a_config_run_of_the_plugin_lands_in_the_comparison(installed, corpus, tmp_path):
+def test_a_config_run_of_the_plugin_lands_in_the_comparison(installed, runs, overlay,
+                                                            tmp_path):
+    """On a copy of the reference run, with the same config plus one run of the plugin:
+    the plugin's detect job runs and its row lands in the comparison, while the other
+    methods' detections are kept, not redone."""
+    work = tmp_path / "run"
+    shutil.copytree(runs[0], work, symlinks=True)
+    kept = (work / "results/detections/rls_arx_zscore").stat().st_mtime_ns
     extra = tmp_path / "plugin.yaml"
     extra.write_text(yaml.safe_dump({"methods": {"cusum_roll": {"detector": "cusum"}}}))
-    env = {**installed, "ALFA_DIR": str(corpus.parent)}
+    env = {k: v for k, v in installed.items() if k != "ALFA_DIR"}   # the run's download
     done = subprocess.run([sys.executable, "-m", "snakemake", "results/tables/comparison.md",
                            "--cores", "2", "--quiet", "--snakefile", str(REPO / "Snakefile"),
-                           "--directory", str(tmp_path), "--configfile",
-                           str(REPO / "config/config.yaml"), str(extra)],
+                           "--directory", str(work), "--configfile",
+                           str(REPO / "config/config.yaml"), str(overlay[0]), str(extra)],
                           capture_output=True, text=True, env=env)
     assert done.returncode == 0, done.stdout + done.stderr
-    table = (tmp_path / "results/tables/comparison.md").read_text()
+    table = (work / "results/tables/comparison.md").read_text()
     assert "| cusum_roll | cusum |" in table
+    assert (work / "results/detections/rls_arx_zscore").stat().st_mtime_ns == kept
