@@ -27,12 +27,16 @@ from collections import defaultdict
 from functools import cache
 from pathlib import Path
 
+from alfa_bench.data import read_manifest
+
 REPO = Path(__file__).resolve().parent.parent
 FLIGHTS = (47, 470, 4700)
 
 
 def job_seconds(run: Path) -> dict[str, list[float]]:
-    """Each rule's jobs' wall seconds, from ``run/results/benchmarks/``."""
+    """Each rule's jobs' wall seconds, from ``run/results/benchmarks/``. The reference
+    runs' detect jobs (rule detect_reference) write theirs under ``detect/`` too, and
+    are counted there: they run beside the other detect jobs."""
     seconds = defaultdict(list)
     for tsv in sorted((run / "results/benchmarks").rglob("*.tsv")):
         rule = tsv.parent.name if tsv.parent.name != "benchmarks" else tsv.stem
@@ -76,8 +80,7 @@ def main() -> None:
     parser.add_argument("--nodes", type=int, default=50)
     args = parser.parse_args()
     seconds = job_seconds(args.run)
-    with open(args.run / "results/flights.csv") as f:
-        measured = sum(1 for row in csv.reader(f) if row and not row[0].startswith("#")) - 1
+    measured = len(read_manifest(args.run / "results/flights.csv"))
     after = rule_graph(args.run)
     jobs = sum(len(v) for v in seconds.values())
     print(f"{jobs} jobs measured on {measured} flights; each job's time scaled by "

@@ -37,8 +37,7 @@ PORTS = {"ctld_port": 16817, "slurmd_port": 16818, "dbd_port": 16819, "db_port":
 
 def slurm_unavailable() -> str | None:
     """Why no cluster can be brought up here, or None."""
-    missing = [p for p in (*DAEMONS, *CLIENTS)
-               if shutil.which(p) is None and not Path("/usr/sbin", p).exists()]
+    missing = [p for p in (*DAEMONS, *CLIENTS) if not Path(_program(p)).exists()]
     if missing:
         return (f"SLURM is not installed here (no {', '.join(missing)}): .ci/run installs "
                 "Debian's slurmctld slurmd slurmdbd slurm-client munge mariadb-server")
@@ -169,8 +168,6 @@ class SlurmRun:
 
     workdir: Path
     done: subprocess.CompletedProcess
-    up_s: float                 # bringing the cluster up
-    run_s: float                # the workflow, through SLURM
     accounting: list[dict]      # sacct: one row per job (JobID, Comment, State, ...)
     killed: dict | None         # the job killed once while it ran (JobID, Comment)
     left_running: list[str]     # the cluster's processes still alive after it stopped
@@ -186,9 +183,7 @@ def through_slurm(root: Path, workdir: Path, prefix: str,
     crash would end it, and SLURM records it FAILED. (``scancel`` proper is no test of
     a retry: SLURM then records "CANCELLED by <uid>", which the executor plugin 2.8
     takes for a running job, so the run waits for ever; docs/speed.md.)"""
-    t0 = time.monotonic()
     with slurm_cluster(root) as env:
-        t1 = time.monotonic()
         stop, killed = threading.Event(), {}
         killer = threading.Thread(target=_kill_one, args=(env, prefix, stop, killed))
         killer.start()
@@ -197,10 +192,8 @@ def through_slurm(root: Path, workdir: Path, prefix: str,
         finally:
             stop.set()
             killer.join()
-        t2 = time.monotonic()
         accounting = _sacct(env)
-    return SlurmRun(workdir, done, t1 - t0, t2 - t1, accounting, killed or None,
-                    running(root))
+    return SlurmRun(workdir, done, accounting, killed or None, running(root))
 
 
 def _kill_one(env: dict, prefix: str, stop: threading.Event, killed: dict) -> None:

@@ -27,7 +27,11 @@ MEMORY_HEADROOM, TIME_HEADROOM, MIN_MINUTES = 2.0, 3.0, 5
 
 
 def count_flights(processed: Path) -> int:
-    """Flight folders under ``processed`` (the archive's count before it is downloaded)."""
+    """Folders under ``processed`` (the archive's count before it is downloaded).
+
+    Every parse of the workflow counts them, each job's too, so this lists the folder
+    and no more; which of them are flights the manifest decides (``find_flights`` looks
+    into each)."""
     if not processed.is_dir():
         return ALFA_FLIGHTS
     return sum(p.is_dir() for p in processed.iterdir())
