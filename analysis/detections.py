@@ -38,6 +38,7 @@ from alfa_bench.methods import (
     Detector,
     Fork,
     Trace,
+    clone,
     fault_free_segments,
     forks,
     labelled_segments,
@@ -69,11 +70,15 @@ INJECTED_RECORDS = "records.jsonl"
 def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest: pd.DataFrame,
                calibration: dict, failures: list[dict] | None = None,
                calibrate_on: pd.DataFrame | None = None, detector: Detector | None = None,
-               stability: dict | None = None) -> Iterator[tuple[dict, Trace]]:
+               stability: dict | None = None, fitted: dict | None = None
+               ) -> Iterator[tuple[dict, Trace]]:
     """Records and traces (with probes) of ``spec`` (``{"detector": name, "params":
     {...}}``) on every flight of ``manifest`` with ground truth; ``calibration`` is
-    ``{"group_by", "margin_s"}``. The detector run is ``detector`` if given (unfitted;
-    ``spec`` then names it in the records), else the registry's ``spec``.
+    ``{"group_by", "margin_s"}``. The detector run is a clone of ``detector`` if given
+    (unfitted; ``spec`` then names it in the records; it is left as it was), else the
+    registry's ``spec``. Each fold fits a clone of its own; with ``fitted`` (a dict),
+    each fold's fitted detector is put there by fold name (``""`` for an uncalibrated
+    detector's one run).
 
     With ``stability`` (``{"pools", "seed"}``), each fold also draws that many pools of
     its calibration flights (:func:`~.stability.pool_draws`), and each real flight's
@@ -95,9 +100,12 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
     train = manifest if calibrate_on is None else calibrate_on
     sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
     sha |= dict(zip(train["flight"], train["sha256"], strict=True))
-    runner = _FoldRunner(method, spec, detector, flights, sha, calibration, failures,
+    runner = _FoldRunner(method, spec, clone(detector), flights, sha, calibration, failures,
                          _sources(manifest), stability, _fault_free_s(train, calibration))
+    if fitted is not None:
+        runner.fitted = fitted
     if not detector.calibrated:
+        runner.fitted[""] = runner.detector
         for name in manifest.loc[manifest["ground_truth"], "flight"]:
             if (out := runner.record(name)) is not None:
                 yield out
@@ -169,6 +177,8 @@ class _FoldRunner:
         self.failures, self.sources = failures, sources
         self.stability, self.fault_free_s = stability, fault_free_s or {}
         self.failed: set[str] = set()
+        # each fold's fitted clone of ``detector``, by fold
+        self.fitted: dict[str, Detector] = {}
         self.forks: dict[str, dict[float, Fork]] = {}
         # the fold's pool thresholds (pools, channels), or None
         self.pools: np.ndarray | None = None
@@ -211,9 +221,11 @@ class _FoldRunner:
 
     def fit(self, fold: str, training: list[str], scored: list[str],
             group: dict[str, str]) -> dict | None:
-        """Fit the detector on the readable, measured ``training`` flights of ``fold``;
-        the calibration block of its records, or None if it could not be fitted."""
-        detector, margin_s = self.detector, self.calibration["margin_s"]
+        """Fit a clone of the detector on the readable, measured ``training`` flights of
+        ``fold``; the calibration block of its records, or None if it could not be
+        fitted."""
+        detector = self.detector = clone(self.detector)
+        margin_s = self.calibration["margin_s"]
         segments = {f: self.guarded("calibration", f, lambda f=f: (
             labelled_segments(detector, [self.flights[f]]) if detector.supervised else
             fault_free_segments(detector, [self.flights[f]], margin_s)))
@@ -228,11 +240,13 @@ class _FoldRunner:
         self.pools = None
         try:
             detector.fit(data)
+            _check_thresholds(detector)
         except CalibrationError as e:
             self.uncalibrated(scored, CalibrationError(
                 f"fold {fold} ({len(used)} calibration flights): {e}"))
             return None
         log.info("%s: fold %s fitted on %d flights", self.method, fold, len(used))
+        self.fitted[fold] = detector
         if self.stability:
             self.pools = self._pool_thresholds(fold, training, used, scored, group)
         return {**self.calibration, "fold": fold, "flights": used, "not_measured": dead,
@@ -253,6 +267,16 @@ class _FoldRunner:
         kept = set(used)
         return self.detector.pool_thresholds(
             [{f: n for f, n in d.items() if f in kept} for d in draws])
+
+
+def _check_thresholds(detector: Detector) -> None:
+    """A fitted detector's thresholds are finite and positive, or it is not calibrated."""
+    gamma = np.asarray(detector.thresholds(), dtype=float)
+    if not np.all(np.isfinite(gamma) & (gamma > 0)):
+        bad = {c: float(g) for c, g in zip(detector.channels(), gamma, strict=True)
+               if not (np.isfinite(g) and g > 0)}
+        raise CalibrationError(f"{type(detector).__name__} fitted thresholds that are not "
+                               f"finite and positive: {bad}")
 
 
 @dataclass(frozen=True)

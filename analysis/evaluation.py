@@ -186,6 +186,9 @@ class Result:
         The flights not scored, and why.
     injected : list of dict
         The records of the injected sensor-fault grid, if asked for.
+    fitted : dict of str to Detector
+        Per fold, the clone of the detector fitted for it (one under ``""`` for an
+        uncalibrated detector): the caller's detector is never fitted.
     """
 
     method: str
@@ -199,6 +202,7 @@ class Result:
     detector: Detector = field(repr=False)
     subsets: list[str] = field(repr=False)
     deadline_s: float = field(repr=False)
+    fitted: dict[str, Detector] = field(default_factory=dict, repr=False)
 
     def recording(self, flight: str, path: str | os.PathLike) -> Path:
         """Write the rerun recording of ``flight`` with this method's scores and
@@ -226,7 +230,7 @@ def _subsets(config: dict) -> list[str]:
 
 def evaluate(detector: Detector | str, corpus: Corpus, *, name: str | None = None,
              subsets: list[str] | None = None, deadline_s: float | None = None,
-             injected: bool = False) -> Result:
+             injected: bool = False, check: bool = True) -> Result:
     """Score ``detector`` on every labelled flight of ``corpus``, as the workflow does.
 
     Parameters
@@ -245,13 +249,27 @@ def evaluate(detector: Detector | str, corpus: Corpus, *, name: str | None = Non
         Default: the config's ``scoring.deadline_s``.
     injected : bool
         Also score the config's injected sensor-fault grid (:attr:`Result.injected`).
+    check : bool
+        Run the quick contract checks on a detector instance first (shapes, thresholds,
+        causality on one synthetic flight: :func:`~alfa_bench.methods.checks.quick_check`,
+        about a second); a config run's detector is checked by the test suite.
+
+    ``detector`` is never fitted itself: each fold fits a clone (:attr:`Result.fitted`).
     """
     config = corpus.config
     if isinstance(detector, str):
+        if detector not in config["methods"]:
+            raise KeyError(f"no run {detector!r} in the config; its runs: "
+                           f"{', '.join(config['methods'])}. Pass one of them, or a "
+                           "Detector instance")
         spec = config["methods"][detector]
         name = name or detector
         detector = make_detector(spec["detector"], spec.get("params"))
     else:
+        if check:
+            from alfa_bench.methods.checks import quick_check  # the synthetic corpus
+
+            quick_check(detector)
         spec = {"detector": detector_name(detector), "params": detector.get_params()}
         name = name or type(detector).__name__.lower()
     subsets = list(subsets or _subsets(config))
@@ -262,13 +280,13 @@ def evaluate(detector: Detector | str, corpus: Corpus, *, name: str | None = Non
         flights, grid = _with_grid(corpus)
     scored = pd.concat([manifest, grid], ignore_index=True) if len(grid) else manifest
     failed: list[dict] = []
-    records, traces, extra, on_grid = [], {}, [], set(grid["flight"])
+    records, traces, extra, on_grid, fitted = [], {}, [], set(grid["flight"]), {}
     # one BLAS thread, as Snakemake gives each job: a least-squares fit on two threads
     # differs from the workflow's in its last digits
     with threadpool_limits(1, user_api="blas"):
         for record, trace in detect_all(name, spec, flights, scored, config["calibration"],
                                         failed, calibrate_on=manifest, detector=detector,
-                                        stability=config.get("stability")):
+                                        stability=config.get("stability"), fitted=fitted):
             if record["flight"] in on_grid:
                 extra.append(record)
             else:
@@ -281,7 +299,7 @@ def evaluate(detector: Detector | str, corpus: Corpus, *, name: str | None = Non
     summary = comparison_table(records, manifest, subsets, deadline_s, failures,
                                *_stable(config))
     return Result(name, records, traces, per_flight, summary, failures, extra, corpus,
-                  detector, subsets, deadline_s)
+                  detector, subsets, deadline_s, fitted)
 
 
 def _with_grid(corpus: Corpus) -> tuple[Mapping[str, Flight], pd.DataFrame]:

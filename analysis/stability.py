@@ -156,7 +156,13 @@ def stability_table(records: list[dict], manifest: pd.DataFrame, subsets, deadli
                     "stable_detections", "fault_free_alarms_mean", "fault_free_alarms_low",
                     "fault_free_alarms_high")} | {"pools": 0}
             rows.append(row)
-    return pd.DataFrame(rows)
+    return pd.DataFrame(rows, columns=_STABILITY_COLUMNS)
+
+
+_STABILITY_COLUMNS = ["method", "subset", "deadline_s", "detections", "fault_free_alarms",
+                      "fault_free_flights", "detections_mean", "detections_low",
+                      "detections_high", "stable_detections", "fault_free_alarms_mean",
+                      "fault_free_alarms_low", "fault_free_alarms_high", "pools"]
 
 
 def calibration_table(records: list[dict]) -> pd.DataFrame:

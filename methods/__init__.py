@@ -23,6 +23,7 @@ from .base import (
     PairDetector,
     StaleStateError,
     Trace,
+    clone,
     fault_free_segments,
     fit_token,
     forks,
@@ -35,7 +36,7 @@ from .extremes import MaximaThresholds
 
 __all__ = ["BUILTIN", "BUILTIN_ENTRIES", "DEFAULT_RATE_HZ", "PLUGIN_GROUP", "REGISTRY",
            "CalibrationError", "Detector", "Fork", "Labelled", "MaximaThresholds",
-           "NotFittedError", "PairDetector", "StaleStateError", "Trace", "detector_name",
+           "NotFittedError", "PairDetector", "StaleStateError", "Trace", "clone", "detector_name",
            "fault_free_segments", "fit_token", "forks", "labelled_segments", "make_detector",
            "plugins", "run_detector", "skipped_channels", "training_segments"]
 

@@ -51,11 +51,13 @@ row.
 from __future__ import annotations
 
 import copy
+import functools
 import hashlib
 import inspect
-import json
 import logging
+import math
 from abc import ABC, abstractmethod
+from collections import deque
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -63,9 +65,9 @@ import numpy as np
 from alfa_bench.data import Flight, Sampled, not_measured, sample
 
 __all__ = ["DEFAULT_RATE_HZ", "CalibrationError", "Detector", "Fork", "Labelled",
-           "NotFittedError", "PairDetector", "StaleStateError", "Trace", "fault_free_segments",
-           "fit_token", "forks", "labelled_segments", "run_detector", "skipped_channels",
-           "training_segments"]
+           "NotFittedError", "PairDetector", "StaleStateError", "Trace", "clone",
+           "fault_free_segments", "fit_token", "forks", "json_ready", "labelled_segments",
+           "learned_state", "run_detector", "skipped_channels", "training_segments"]
 
 log = logging.getLogger(__name__)
 
@@ -90,12 +92,119 @@ class StaleStateError(RuntimeError):
     hyper-parameters than the detector now has."""
 
 
+def learned_state(detector: Detector) -> dict:
+    """The learned attributes of ``detector`` (names ending in ``_``), by name."""
+    return {n: v for n, v in vars(detector).items()
+            if n.endswith("_") and not n.startswith("_")}
+
+
+def _feed(h, value, seen: set[int]) -> None:
+    """Feed ``value`` to the hash ``h`` by value: arrays by their bytes, containers by
+    their items, other objects by their attributes (``repr`` only for what has none)."""
+    if isinstance(value, np.ndarray | np.generic):
+        value = np.asarray(value)
+        h.update(f"<{value.dtype.str}{value.shape}>".encode())
+        if value.dtype.hasobject:
+            for item in value.ravel():
+                _feed(h, item, seen)
+        else:
+            h.update(np.ascontiguousarray(value).tobytes())
+    elif value is None or isinstance(value, str | int | float | complex | bytes):
+        h.update(f"{type(value).__name__}:{value!r};".encode())
+    elif isinstance(value, dict):
+        h.update(b"{")
+        for k, v in value.items():
+            _feed(h, k, seen)
+            _feed(h, v, seen)
+        h.update(b"}")
+    elif isinstance(value, list | tuple | deque):
+        h.update(f"{type(value).__name__}[".encode())
+        for v in value:
+            _feed(h, v, seen)
+        h.update(b"]")
+    elif isinstance(value, set | frozenset):
+        _feed(h, sorted(value, key=repr), seen)
+    elif hasattr(value, "__dict__") and id(value) not in seen:
+        seen.add(id(value))
+        h.update(f"{type(value).__module__}.{type(value).__qualname__}".encode())
+        _feed(h, vars(value), seen)
+    else:
+        h.update(repr(value).encode())
+
+
+def _digest(*values) -> str:
+    h = hashlib.blake2b(digest_size=16)
+    for v in values:
+        _feed(h, v, set())
+    return h.hexdigest()
+
+
 def fit_token(detector: Detector) -> str:
     """What a running state belongs to: a digest of the detector's hyper-parameters and
-    of what :meth:`~Detector.fit` learned (:meth:`~Detector.fitted`)."""
-    text = json.dumps([detector.get_params(), detector.fitted()], sort_keys=True,
-                      default=repr)
-    return hashlib.blake2b(text.encode(), digest_size=16).hexdigest()
+    of every attribute its last :meth:`~Detector.fit` (or
+    :meth:`~Detector.rethreshold`) left, by value (``fit_digest_``, set when the fit
+    returns)."""
+    return _digest(detector.get_params(), getattr(detector, "fit_digest_", None))
+
+
+def json_ready(value):
+    """``value`` as JSON-ready values: arrays as lists, non-finite floats as None,
+    mapping keys as strings, a detector as its :meth:`~Detector.fitted`, another object
+    as its attributes (its ``repr`` where it has none)."""
+    if isinstance(value, np.ndarray | np.generic):
+        return json_ready(np.asarray(value).tolist())
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if value is None or isinstance(value, str | int | bool):
+        return value
+    if isinstance(value, dict):
+        return {str(k): json_ready(v) for k, v in value.items()}
+    if isinstance(value, list | tuple | deque | set | frozenset):
+        return [json_ready(v) for v in value]
+    if isinstance(value, Detector):
+        return value.fitted()
+    if hasattr(value, "__dict__"):
+        return json_ready(vars(value))
+    return repr(value)
+
+
+def clone(detector: Detector) -> Detector:
+    """A new, unfitted detector with a copy of ``detector``'s hyper-parameters."""
+    return type(detector)(**copy.deepcopy(detector.get_params()))
+
+
+#: ids of the detectors inside a sealed fit, so that a fit calling its parent's fit
+#: starts from nothing once and is sealed once it returns
+_FITTING: set[int] = set()
+
+
+def _sealed(method, forget: bool):
+    """``method`` (a :meth:`~Detector.fit` or :meth:`~Detector.rethreshold`) made safe by
+    construction: a fit first forgets every learned attribute (``forget``), so that a
+    refit is a fresh fit; on return, ``fit_digest_`` digests by value what it left, so
+    that no state taken under another fit can be continued (:func:`fit_token`)."""
+    @functools.wraps(method)
+    def sealed(self, *args, **kwargs):
+        if id(self) in _FITTING:
+            return method(self, *args, **kwargs)
+        _FITTING.add(id(self))
+        try:
+            if forget:
+                for name in learned_state(self):
+                    delattr(self, name)
+            out = method(self, *args, **kwargs)
+        finally:
+            _FITTING.discard(id(self))
+        learned = learned_state(self)
+        learned.pop("fit_digest_", None)
+        if forget and self.calibrated and type(self).fitted is Detector.fitted:
+            learned.pop("fit_report_", None)
+            self.fit_report_ = json_ready(learned)
+        self.fit_digest_ = _digest(learned)
+        return out
+
+    sealed.seals_the_fit = True
+    return sealed
 
 
 @dataclass(frozen=True)
@@ -130,6 +239,13 @@ class Detector(ABC):
     #: :meth:`rethreshold` sets the thresholds for new values without fitting again
     threshold_params: tuple[str, ...] = ()
 
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        for name in ("fit", "rethreshold"):
+            method = getattr(cls, name)
+            if not getattr(method, "seals_the_fit", False):
+                setattr(cls, name, _sealed(method, forget=name == "fit"))
+
     @classmethod
     def param_names(cls) -> list[str]:
         """The hyper-parameters' names: those of ``__init__`` (none without one)."""
@@ -162,12 +278,20 @@ class Detector(ABC):
     def fit(self, segments: list[Sampled] | list[Labelled]) -> Detector:
         """Learn from fault-free ``segments`` (sampled with :meth:`signals` at
         :attr:`rate_hz`), or from :class:`Labelled` ones if :attr:`supervised`; return
-        self. Uncalibrated detectors learn nothing here."""
+        self. Uncalibrated detectors learn nothing here.
+
+        Every subclass's fit is sealed by the base class: it starts from no learned
+        attribute (a refit is a fresh fit), and what it leaves is digested by value
+        into ``fit_digest_`` (:func:`fit_token`)."""
         return self
 
     def fitted(self) -> dict:
-        """What :meth:`fit` learned, as JSON-ready values (empty if uncalibrated)."""
-        return {}
+        """What :meth:`fit` learned, as JSON-ready values (:func:`json_ready`): by
+        default every learned attribute as the fit left it; empty if uncalibrated."""
+        if not self.calibrated:
+            return {}
+        self._check_fitted("fit_report_")
+        return self.fit_report_
 
     def _check_fitted(self, attribute: str) -> None:
         if not hasattr(self, attribute):
@@ -252,10 +376,25 @@ class Detector(ABC):
         names = list(self.probes()) if probes else []
         kept = np.full((n, len(names)), np.nan)
         for k in range(n):
-            score[k] = self.update(s.x[start + k], s.fresh[start + k])
+            try:
+                score[k] = self.update(s.x[start + k], s.fresh[start + k])
+            except ValueError as e:
+                raise self._wrong_scores(s.x[start + k], s.fresh[start + k]) or e from e
             if names:
                 kept[k] = list(self.probes().values())
         return score, {name: kept[:, i] for i, name in enumerate(names)}
+
+    def _wrong_scores(self, x: np.ndarray, fresh: np.ndarray) -> ValueError | None:
+        """Where :meth:`update` returns other than one score per channel, the error that
+        says so (the step is taken again on a copy); None where it does not."""
+        out = np.asarray(copy.deepcopy(self).update(x, fresh))
+        channels = self.channels()
+        if out.shape == (len(channels),):
+            return None
+        return ValueError(f"{type(self).__name__}.update() returned {out.size} value(s) of "
+                          f"shape {out.shape} ({np.array2string(out, threshold=8)}) for "
+                          f"{len(channels)} channel(s) {list(channels)}: return one score "
+                          "per channel, or name the channels in channels()")
 
     @abstractmethod
     def update(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:

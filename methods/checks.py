@@ -17,6 +17,11 @@ and raises ``AssertionError`` where the contract fails:
   ``reset`` forgets the previous flight; a run continued from a snapshot (forked)
   equals the run from t = 0; where hyper-parameters set only the thresholds,
   re-thresholding a fit for new values equals fitting with them;
+- a refit is a fresh fit: one instance fitted on other data, then on the check's,
+  gives what a new one fitted on the check's gives, and a state taken under the first
+  fit is refused under the second; per-flight maxima that do not vary give a
+  :class:`~.base.CalibrationError`, from the point fit and the pool fit alike, never
+  an infinite or NaN threshold;
 - it is causal: changing the data after time *t* changes no output before *t*.
 
 A plugin's own tests run them all with one decorator::
@@ -33,6 +38,7 @@ from __future__ import annotations
 import copy
 import inspect
 import json
+import logging
 import shutil
 import tempfile
 from functools import cache
@@ -44,14 +50,25 @@ from alfa_bench.data import SIGNALS, load_flight, sample
 from alfa_bench.data.synthetic import write_corpus
 
 from .base import (
+    CalibrationError,
     Detector,
     NotFittedError,
+    StaleStateError,
+    fit_token,
     forks,
     run_detector,
     training_segments,
 )
+from .extremes import MaximaThresholds
 
-__all__ = ["CHECKS", "parametrize_with_checks"]
+__all__ = ["CHECKS", "QUICK_CHECKS", "ContractError", "parametrize_with_checks",
+           "quick_check"]
+
+log = logging.getLogger(__name__)
+
+
+class ContractError(ValueError):
+    """A detector breaks the contract: which check, what it found, and what to do."""
 
 #: the corpus flight the checks run a detector on
 _FLIGHT = "carbonZ_2018-07-18-15-53-31_1_engine_failure"
@@ -65,8 +82,9 @@ def _corpus() -> Path:
     return processed
 
 
-def _fit(detector: Detector) -> Detector:
-    training = [load_flight(p) for p in sorted(_corpus().iterdir())]
+def _fit(detector: Detector, leave_out: int = 0) -> Detector:
+    """``detector`` fitted on the corpus, less its first ``leave_out`` flights."""
+    training = [load_flight(p) for p in sorted(_corpus().iterdir())[leave_out:]]
     return detector.fit(training_segments(detector, training, margin_s=1.0))
 
 
@@ -150,7 +168,7 @@ def check_each_channel_has_one_positive_threshold(detector: Detector) -> None:
     d = _fitted(detector)
     trace = run_detector(d, _flight())
     assert trace.threshold.shape == (len(d.channels()),)
-    assert np.all(trace.threshold > 0)
+    assert np.all(np.isfinite(trace.threshold) & (trace.threshold > 0)), trace.threshold
     np.testing.assert_array_equal(trace.alarm, d.alarms(trace.score))
 
 
@@ -235,6 +253,57 @@ def check_rethreshold_equals_fit(detector: Detector) -> None:
             assert not np.array_equal(moved.thresholds(), d.thresholds()), name
 
 
+def check_a_refit_is_a_fresh_fit(detector: Detector) -> None:
+    """One instance fitted on other data (the corpus less two flights), run, then fitted
+    on the check's, equals a new one fitted on the check's: what fit learned, its
+    :func:`~.base.fit_token` and the run. A state taken under the first fit is
+    refused under the second, where the two fits learned differently. An
+    uncalibrated detector has nothing to check."""
+    if not detector.calibrated:
+        return
+    d = copy.deepcopy(detector)
+    try:
+        _fit(d, leave_out=2)
+    except CalibrationError:
+        first = None                   # the check's data alone then: a failed fit first
+    else:
+        run_detector(d, _flight())
+        first = fit_token(d), forks(d, _flight(), [0.5 * _flight().duration_s])
+    _fit(d)
+    fresh = _fitted(detector)
+    assert d.fitted() == fresh.fitted()
+    assert fit_token(d) == fit_token(fresh)
+    _assert_same(run_detector(d, _flight()), run_detector(fresh, _flight()))
+    if first is not None and first[1] and first[0] != fit_token(d):
+        fork = next(iter(first[1].values()))
+        try:
+            fork.continued(d, sample(_flight(), d.signals(), d.rate_hz), probes=False)
+        except StaleStateError:
+            pass
+        else:
+            raise AssertionError("a state taken under another fit was continued")
+
+
+def check_maxima_that_do_not_vary_cannot_calibrate(detector: Detector) -> None:
+    """Thresholds from per-flight maxima (:class:`~.extremes.MaximaThresholds`): maxima
+    that are all equal (a constant score) raise :class:`~.base.CalibrationError` from
+    :meth:`~.base.Detector.rethreshold` and from
+    :meth:`~.base.Detector.pool_thresholds` alike. Other detectors have nothing to
+    check."""
+    if not isinstance(detector, MaximaThresholds):
+        return
+    for attempt in ("rethreshold", "pool_thresholds"):
+        d = _fitted(detector)
+        d.maxima_ = {c: [2.5] * max(len(m), 5) for c, m in d.maxima_.items()}
+        d.maxima_flights_ = {c: [f"f{i}" for i in range(len(m))] for c, m in d.maxima_.items()}
+        try:
+            d.rethreshold() if attempt == "rethreshold" else d.pool_thresholds(
+                [{"f0": 2, "f1": 3}])
+        except CalibrationError:
+            continue
+        raise AssertionError(f"maxima that do not vary gave a threshold ({attempt})")
+
+
 def check_deterministic(detector: Detector) -> None:
     d, flight = _fitted(detector), _flight()
     _assert_same(run_detector(d, flight), run_detector(d, flight))
@@ -304,10 +373,53 @@ CHECKS = (
     check_batch_run_equals_streaming,
     check_forked_run_equals_run,
     check_rethreshold_equals_fit,
+    check_a_refit_is_a_fresh_fit,
+    check_maxima_that_do_not_vary_cannot_calibrate,
     check_deterministic,
     check_reset_forgets_the_previous_flight,
     check_causal,
 )
+
+
+#: the checks :func:`quick_check` runs: the contract's shape, and causality
+QUICK_CHECKS = (
+    check_constructor_stores_hyper_parameters_only,
+    check_run_takes_the_base_arguments,
+    check_each_channel_names_the_measured_signal_it_scores,
+    check_outputs_have_the_declared_shape,
+    check_each_channel_has_one_positive_threshold,
+    check_causal,
+)
+
+
+def quick_check(detector: Detector) -> None:
+    """Run :data:`QUICK_CHECKS` on ``detector`` (left as it is) on one synthetic flight,
+    as :func:`alfa_bench.evaluate` does before scoring it (about a second).
+
+    A calibrated detector that cannot be fitted on the synthetic corpus
+    (:class:`~.base.CalibrationError`) is checked without a fit: the real flights
+    will say whether it calibrates. A non-causal one is not checked for causality.
+
+    Raises
+    ------
+    ContractError
+        Naming the check that fails, what it found, and what to do."""
+    for check in QUICK_CHECKS:
+        if check is check_causal and not detector.causal:
+            continue
+        try:
+            check(detector)
+        except CalibrationError as e:
+            log.warning("%s cannot be fitted on the synthetic check corpus (%s): the "
+                        "checks that need a fit are left to the real flights",
+                        type(detector).__name__, e)
+            return
+        except (AssertionError, ValueError, TypeError, NotImplementedError) as e:
+            raise ContractError(
+                f"{type(detector).__name__} fails the contract check "
+                f"{check.__name__.removeprefix('check_')}: {type(e).__name__}: {e}\n"
+                "What to do: see docs/adding-a-method.md (the contract); to score it "
+                "anyway, evaluate(..., check=False)") from e
 
 
 def parametrize_with_checks(detectors):

@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from .base import CalibrationError
+from .base import CalibrationError, json_ready, learned_state
 
 __all__ = ["CAP_LEVEL", "MIN_SEGMENTS", "MaximaThresholds", "gumbel_threshold",
            "gumbel_thresholds"]
@@ -52,15 +52,34 @@ def gumbel_threshold(maxima: np.ndarray, level: float) -> float:
         \frac{g(p_{\mathrm{cap}}) - g(1/2)}{g(3/4) - g(1/4)}, \qquad g(p) = -\ln(-\ln p).
 
     Maxima like the others lie far below it, and are fitted as they are; an absurd one
-    weighs as a flight at the cap does."""
+    weighs as a flight at the cap does.
+
+    Raises
+    ------
+    CalibrationError
+        Where the capped maxima do not vary (a score that is constant, or the same on
+        most flights): a law with no spread cannot be fitted, and no finite threshold
+        above every fault-free flight can be read from it."""
     from scipy import stats  # ~0.5 s to import: only where a Gumbel law is fitted
 
     maxima = np.asarray(maxima, dtype=float)
+    if not np.isfinite(maxima).all():
+        raise CalibrationError(f"per-flight maxima {maxima.tolist()} are not all finite")
     q1, q2, q3 = np.quantile(maxima, [0.25, 0.5, 0.75])
     cap = q2 + (q3 - q1) * (_gumbel_unit(CAP_LEVEL) - _gumbel_unit(0.5)) / (
         _gumbel_unit(0.75) - _gumbel_unit(0.25))
-    loc, scale = stats.gumbel_r.fit(np.minimum(maxima, cap))
-    return float(stats.gumbel_r.ppf(level, loc, scale))
+    capped = np.minimum(maxima, cap)
+    if np.ptp(capped) <= 1e-12 * max(1.0, float(np.abs(capped).max())):
+        raise CalibrationError(f"the {maxima.size} per-flight maxima are all "
+                               f"{float(capped[0]):g} once capped: a score that does not "
+                               "vary between fault-free flights gives no extreme-value "
+                               "threshold")
+    loc, scale = stats.gumbel_r.fit(capped)
+    gamma = float(stats.gumbel_r.ppf(level, loc, scale))
+    if not math.isfinite(gamma):
+        raise CalibrationError(f"the Gumbel law of maxima {maxima.tolist()} gives no finite "
+                               f"threshold at level {level}")
+    return gamma
 
 
 def _weighted_quantile(x: np.ndarray, cum: np.ndarray, m: np.ndarray, p: float) -> np.ndarray:
@@ -85,9 +104,19 @@ def gumbel_thresholds(maxima: np.ndarray, counts: np.ndarray, level: float) -> n
         \qquad \mu = -\beta \ln \frac{\sum_i w_i e^{-y_i/\beta}}{\sum_i w_i},
 
     the equations scipy's ``gumbel_r.fit`` solves one pool at a time (a thousand
-    times slower). NaN for a pool of fewer than :data:`MIN_SEGMENTS` maxima."""
+    times slower). NaN for a pool of fewer than :data:`MIN_SEGMENTS` maxima, and for
+    one whose capped maxima do not vary (where :func:`gumbel_threshold` refuses).
+
+    Raises
+    ------
+    CalibrationError
+        Where the maxima themselves do not vary (or are not finite), as
+        :func:`gumbel_threshold` does: then no pool can be fitted."""
     order = np.argsort(maxima)
     x = np.asarray(maxima, dtype=float)[order]
+    if x.size and (not np.isfinite(x).all() or np.ptp(x) <= 1e-12 * max(1.0, np.abs(x).max())):
+        raise CalibrationError(f"the {x.size} per-flight maxima are not finite or do not "
+                               "vary: no pool of them gives an extreme-value threshold")
     w = np.asarray(counts, dtype=float)[:, order]
     cum, m = np.cumsum(w, axis=1), w.sum(axis=1)
     ok = m >= MIN_SEGMENTS
@@ -113,8 +142,12 @@ def gumbel_thresholds(maxima: np.ndarray, counts: np.ndarray, level: float) -> n
             beta = np.maximum(beta - f / slope, 1e-12)
         e = w * np.exp(-(y - low) / beta[:, None])
         gamma = low[:, 0] - beta * np.log(e.sum(axis=1) / m) + beta * _gumbel_unit(level)
-    # a pool of one value has no spread to fit: its threshold is that value
-    out[ok] = np.where(np.isfinite(gamma), gamma, y.max(axis=1))
+    # a pool whose capped maxima do not vary has no law to fit, as gumbel_threshold says
+    drawn_max = np.where(w > 0, y, -np.inf).max(axis=1)
+    drawn_min = np.where(w > 0, y, np.inf).min(axis=1)
+    flat = drawn_max - drawn_min <= 1e-12 * np.maximum(1.0, np.abs(drawn_max))
+    flat |= ~np.isfinite(gamma)
+    out[ok] = np.where(flat, np.nan, gamma)
     return out
 
 
@@ -136,6 +169,8 @@ class MaximaThresholds:
         Per channel, :math:`\gamma_c`.
     maxima_flights_ : dict of str to list of str
         Per channel, the flight of each of ``maxima_`` (:meth:`pool_thresholds`).
+    model_ : tuple of str
+        The attributes :meth:`fit_model` learned (reported by :meth:`fitted`).
     """
 
     calibrated = True
@@ -149,9 +184,9 @@ class MaximaThresholds:
     def fit(self, segments) -> MaximaThresholds:
         """:meth:`fit_model`, then the maxima of the scores of ``segments`` and
         :meth:`rethreshold`."""
-        for attr in ("maxima_", "gamma_", "maxima_flights_"):
-            self.__dict__.pop(attr, None)
         self.fit_model(segments)
+        # a fit starts from no learned attribute (Detector.fit): these are the model's
+        self.model_ = tuple(learned_state(self))
         maxima = {c: [] for c in self.channels()}
         flights = {c: [] for c in self.channels()}
         for s in segments:
@@ -204,6 +239,9 @@ class MaximaThresholds:
         return out
 
     def fitted(self) -> dict:
-        """The maxima and the thresholds, per channel."""
+        """The maxima and the thresholds, per channel, and what :meth:`fit_model`
+        learned (``model``, where it learned anything)."""
         self._check_fitted("gamma_")
-        return {"segment_maxima": self.maxima_, "gamma": self.gamma_}
+        model = {n: json_ready(getattr(self, n)) for n in self.model_}
+        return {"segment_maxima": self.maxima_, "gamma": self.gamma_,
+                **({"model": model} if model else {})}

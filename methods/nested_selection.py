@@ -32,7 +32,9 @@ inner fit without dates :math:`\{o, d\}` comes twice: scoring :math:`o` with :ma
 held out, and scoring :math:`d` with :math:`o` held out. Each inner fit is therefore
 kept, keyed by the candidate and the exact data it was fitted on (a digest of every
 segment's samples), and given again when the same data comes back; fits are
-deterministic, so this changes no result, and halves the inner fits. Candidates that
+deterministic, so this changes no result, and halves the inner fits. They are kept for
+the process (:data:`INNER_FITS`), not in the detector: each fold fits a clone of it,
+and a fit starts from nothing (:meth:`~.base.Detector.fit`). Candidates that
 differ only in hyper-parameters that set the thresholds
 (:attr:`~.base.Detector.threshold_params`, such as a false-alarm rate) give the same
 scores: one of them is fitted and run, the others take its fit re-thresholded
@@ -44,6 +46,7 @@ from __future__ import annotations
 import copy
 import hashlib
 import itertools
+import json
 import logging
 import math
 
@@ -54,9 +57,14 @@ from alfa_bench.data.flight import parse_flight_name
 
 from .base import CalibrationError, Detector, Labelled
 
-__all__ = ["NestedSelection", "held_out_right"]
+__all__ = ["INNER_FITS", "NestedSelection", "held_out_right"]
 
 log = logging.getLogger(__name__)
+
+#: every inner fit made in this process (the fitted detector, or the
+#: :class:`~.base.CalibrationError` it could not be fitted with), by the selection's
+#: hyper-parameters, the candidate and the digest of its data
+INNER_FITS: dict[tuple, Detector | CalibrationError] = {}
 
 
 def _digest(s: Sampled) -> bytes:
@@ -114,11 +122,6 @@ class NestedSelection(Detector):
         the training dates without which it could not be fitted.
     base_ : Detector
         The base detector with ``chosen_``, fitted on every training flight.
-    inner_fits_ : dict
-        Every inner fit made so far, by candidate and data digest (the fitted detector,
-        or the :class:`~.base.CalibrationError` it could not be fitted with); kept
-        across :meth:`fit` calls, since the folds repeat half of them (module
-        docstring).
     """
 
     calibrated = True
@@ -252,14 +255,15 @@ class NestedSelection(Detector):
     def _inner_fit(self, i: int, first: int, made: list[Detector], data: tuple,
                    training: list[Labelled]) -> Detector | CalibrationError:
         """Candidate ``i`` fitted on ``training`` (whose digest is ``data``), or the
-        :class:`~.base.CalibrationError` it cannot be fitted with; kept in :attr:`inner_fits_`. A
-        candidate that differs from candidate ``first`` of its group in
-        :attr:`~.base.Detector.threshold_params` alone is that fit, re-thresholded."""
-        kept = self.__dict__.setdefault("inner_fits_", {})
-        key = (i, data)
+        :class:`~.base.CalibrationError` it cannot be fitted with; kept in
+        :data:`INNER_FITS`. A candidate that differs from candidate ``first`` of its
+        group in :attr:`~.base.Detector.threshold_params` alone is that fit,
+        re-thresholded."""
+        kept, selection = INNER_FITS, json.dumps(self.get_params(), sort_keys=True)
+        key = (selection, i, data)
         if key in kept:
             return kept[key]
-        shared = kept.get((first, data)) if i != first else None
+        shared = kept.get((selection, first, data)) if i != first else None
         try:
             if shared is None or isinstance(shared, CalibrationError):
                 kept[key] = copy.deepcopy(made[i].fit(self._free(training)))

@@ -126,6 +126,40 @@ def test_evaluate_scores_a_three_member_detector_and_compare_ranks_it(local):
         ab.compare(result, result, published=None)
 
 
+def test_evaluate_fits_clones_and_leaves_the_callers_detector_as_it_was(local):
+    mine = ab.make_detector("residual_bank")
+    before = dict(vars(mine))
+    result = ab.evaluate(mine, local)
+    assert vars(mine) == before
+    folds = {r["calibration"]["fold"] for r in result.records}
+    assert set(result.fitted) == folds and len(folds) > 1
+    assert all(d is not mine and d.fitted() == next(
+        r["calibration"]["fitted"] for r in result.records if r["calibration"]["fold"] == f)
+        for f, d in result.fitted.items())
+
+
+class Constant(ab.MaximaThresholds, Detector):
+    """A score that never varies: its per-flight maxima give no threshold."""
+
+    def __init__(self, false_alarm=0.1):
+        self.false_alarm = false_alarm
+
+    def signals(self):
+        return ("roll",)
+
+    def update(self, x, fresh):
+        return np.array([1.0])
+
+
+def test_a_constant_score_is_a_calibration_failure_row_not_a_crash(local):
+    result = ab.evaluate(Constant(), local, check=False)
+    assert not result.records
+    rows = result.failures[result.failures["method"] == "constant"]
+    assert len(rows) == local.manifest["ground_truth"].sum()
+    assert set(rows["stage"]) == {"calibration"}
+    assert rows["error"].str.contains("do not vary|does not vary").all()
+
+
 def test_a_configured_run_is_scored_with_its_parameters_and_its_grid(local):
     result = ab.evaluate("residual_bank_energy", local, injected=True, deadline_s=2.0)
     assert result.method == "residual_bank_energy"
@@ -165,3 +199,56 @@ def test_evaluate_gives_the_workflows_records_on_the_real_flights(real_processed
         assert mine["outcome"] == theirs["outcome"], r["flight"]
         assert mine["first_alarm_s"] == theirs["first_alarm_s"], r["flight"]
         assert json.loads(json.dumps(mine, sort_keys=True, default=list)) == theirs
+
+
+class ThreeScores(RollError):
+    def update(self, x, fresh):
+        return np.abs(x[:1]).repeat(3)
+
+
+def test_errors_a_notebook_meets_say_what_to_do(local):
+    with pytest.raises(KeyError, match="its runs: .*residual_bank"):
+        ab.evaluate("no_such_run", local)
+    with pytest.raises(ValueError, match=r"ThreeScores.update\(\) returned 3 value.*"
+                                         r"1 channel\(s\) \['threescores'\]"):
+        ab.evaluate(ThreeScores(), local, check=False)
+    from alfa_bench.methods.checks import ContractError
+
+    with pytest.raises(ContractError, match="check=False"):
+        ab.evaluate(ThreeScores(), local)
+
+
+class Standardised(ab.MaximaThresholds, Detector):
+    """What fit_model learns (mean_) is in the records and in the state's token."""
+
+    def __init__(self, false_alarm=0.1):
+        self.false_alarm = false_alarm
+
+    def signals(self):
+        return ("roll_error",)
+
+    def fit_model(self, segments):
+        self.mean_ = float(np.mean(np.concatenate([s.x[:, 0] for s in segments])))
+        return self
+
+    def update(self, x, fresh):
+        return np.abs(x[:1] - self.mean_)
+
+
+def test_what_fit_model_learned_is_reported_and_guards_the_state(local):
+    import copy
+
+    from alfa_bench.methods import StaleStateError, forks
+
+    result = ab.evaluate(Standardised(), local)
+    d = next(iter(result.fitted.values()))
+    assert d.fitted()["model"] == {"mean_": d.mean_}
+    flight = local.flight(result.records[0]["flight"])
+    fork = next(iter(forks(d, flight, [0.5 * flight.duration_s]).values()))
+    fork.continued(copy.deepcopy(d), fork.sampled, probes=False)
+    moved = copy.deepcopy(d)
+    moved.mean_ += 1.0                 # the model alone moved; maxima and thresholds kept
+    moved.rethreshold()
+    assert moved.fitted()["segment_maxima"] == d.fitted()["segment_maxima"]
+    with pytest.raises(StaleStateError):
+        fork.continued(moved, fork.sampled, probes=False)

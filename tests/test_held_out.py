@@ -63,15 +63,16 @@ class PeakRoll(Detector):
 
 
 def spied(monkeypatch, detector):
-    """``detector``, handed to every detect_all, with the flights of each fit kept."""
+    """``detector``, handed to every detect_all, with the flights of each fit kept (of
+    its class's, since every fold fits a clone)."""
     seen = []
-    fit = detector.fit
+    fit = type(detector).fit
 
-    def spy(segments):
+    def spy(self, segments):
         seen.append({s.flight for s in segments})
-        return fit(segments)
+        return fit(self, segments)
 
-    monkeypatch.setattr(detector, "fit", spy)
+    monkeypatch.setattr(type(detector), "fit", spy)
     monkeypatch.setattr(detections, "make_detector", lambda *a, **k: detector)
     return seen
 

@@ -1,5 +1,6 @@
-"""Nested selection keeps its inner fits across the workflow's folds: the fit without
-dates {o, d} serves both the fold scoring o and the one scoring d, and changes nothing."""
+"""Nested selection keeps its inner fits across the workflow's folds (for the process,
+since each fold fits a clone): the fit without dates {o, d} serves both the fold
+scoring o and the one scoring d, and changes nothing."""
 
 from pathlib import Path
 
@@ -7,6 +8,7 @@ import yaml
 
 from alfa_bench.data.flight import parse_flight_name
 from alfa_bench.methods import labelled_segments, make_detector
+from alfa_bench.methods.nested_selection import INNER_FITS
 
 REPO = Path(__file__).resolve().parent.parent
 
@@ -22,16 +24,22 @@ def test_the_folds_share_inner_fits_and_get_what_fresh_fits_give(corpus_flights)
     date = {n: str(parse_flight_name(n)["date"]) for n in corpus_flights}
     dates = sorted(set(date.values()))
     assert len(dates) >= 3
-    shared, made_fresh = _nested(), 0
+    shared, made_fresh, fitted = _nested(), 0, []
+    INNER_FITS.clear()
     for scored in dates:
         training = [f for n, f in corpus_flights.items()
                     if date[n] != scored and f.fault is not None]
-        segments = labelled_segments(shared, training)
-        fresh = _nested().fit(segments)
-        assert shared.fit(segments).fitted() == fresh.fitted()
-        made_fresh += len(fresh.inner_fits_)
+        fitted.append(shared.fit(labelled_segments(shared, training)).fitted())
+    made_shared = len(INNER_FITS)
+    for scored, kept in zip(dates, fitted, strict=True):
+        INNER_FITS.clear()
+        training = [f for n, f in corpus_flights.items()
+                    if date[n] != scored and f.fault is not None]
+        fresh = _nested().fit(labelled_segments(shared, training))
+        assert fresh.fitted() == kept
+        made_fresh += len(INNER_FITS)
     # each inner fit without two dates comes twice over the folds, and is made once
-    assert 0 < len(shared.inner_fits_) < made_fresh
+    assert 0 < made_shared < made_fresh
 
 
 def test_candidates_apart_in_thresholds_alone_share_one_fit(corpus_flights, monkeypatch):
@@ -49,11 +57,13 @@ def test_candidates_apart_in_thresholds_alone_share_one_fit(corpus_flights, monk
                         lambda self, s: fits.append(self.window_s) or real_fit(self, s))
     nested = _nested()
     nested.grid = {"window_s": [0.5, 1.0], "false_alarm": [0.05, 0.1, 0.2]}
+    INNER_FITS.clear()
     segments = labelled_segments(nested, training)
     shared = nested.fit(segments).fitted()
     together = len(fits)
     monkeypatch.setattr(ResidualBank, "threshold_params", ())
     fits.clear()
+    INNER_FITS.clear()
     apart = _nested()
     apart.grid = nested.grid
     assert apart.fit(segments).fitted() == shared
