@@ -10,6 +10,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 
 from loopback import make_archive, serve_archive  # noqa: E402
 from slurm_cluster import slurm_profile, slurm_unavailable, through_slurm  # noqa: E402
+from unavailable import unavailable  # noqa: E402
 from workflow_runs import GRID, REPO, run_workflow  # noqa: E402
 
 from alfa_bench.data import build_manifest, load_flight, resolve_alfa_dir  # noqa: E402
@@ -28,7 +29,7 @@ def pytest_report_header(config):
 @pytest.fixture(scope="session")
 def real_processed() -> Path:
     if not (REAL_ALFA and (REAL_ALFA / "processed").is_dir()):
-        pytest.skip("real ALFA flights not available: set ALFA_DIR to the folder "
+        unavailable("real ALFA flights not available: set ALFA_DIR to the folder "
                     "holding processed/")
     return REAL_ALFA / "processed"
 

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 from slurm_cluster import ACCOUNT, PARTITION, slurm_unavailable
+from unavailable import require_module, unavailable
 from workflow_runs import assert_same_results
 
 # Snakemake or pip in a subprocess, minutes in all: `pytest -m "not workflow"` skips them
@@ -28,7 +29,7 @@ def snakemake(workdir: Path, alfa_dir: Path, target: str, *args: str
 
 
 def test_the_slurm_profile_is_accepted_by_a_dry_run(corpus, tmp_path):
-    pytest.importorskip("snakemake_executor_plugin_slurm")
+    require_module("snakemake_executor_plugin_slurm")
     done = snakemake(tmp_path, corpus.parent, "all", "-n", "--profile",
                      str(REPO / "profiles/slurm"))
     assert done.returncode == 0, done.stdout + done.stderr
@@ -37,7 +38,7 @@ def test_the_slurm_profile_is_accepted_by_a_dry_run(corpus, tmp_path):
 
 def test_jobs_run_through_the_generic_cluster_executor(corpus, tmp_path):
     """submit.sh stands in for sbatch: a job is submitted, runs apart, and is seen done."""
-    pytest.importorskip("snakemake_executor_plugin_cluster_generic")
+    require_module("snakemake_executor_plugin_cluster_generic")
     submit = REPO / "profiles/local-cluster/submit.sh"
     done = snakemake(tmp_path, corpus.parent, "results/flights.csv", "--profile",
                      str(REPO / "profiles/local-cluster"), "--cluster-generic-submit-cmd",
@@ -50,7 +51,7 @@ def test_jobs_run_through_the_generic_cluster_executor(corpus, tmp_path):
 @pytest.fixture(scope="module")
 def through_slurm(slurm_run):
     if slurm_run is None:
-        pytest.skip(slurm_unavailable())
+        unavailable(slurm_unavailable())
     done = slurm_run.done
     assert done.returncode == 0, (done.stdout + done.stderr)[-6000:]
     return slurm_run

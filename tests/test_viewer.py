@@ -7,16 +7,18 @@ import urllib.request
 import numpy as np
 import pytest
 
+from unavailable import require_module, unavailable
+
 from alfa_bench.data import load_flight
 from alfa_bench.methods import make_detector, run_detector
 from alfa_bench.outputs.rerun_log import write_rerun_log
 from alfa_bench.workflow.viewer import check_screenshot, chromium, screenshot, serve_recording
 
-pytest.importorskip("playwright", reason="Playwright is not installed: the viewer check "
-                                         "did not run")
+require_module("playwright", "Playwright is not installed: the viewer check did not run",
+               module_level=True)
 if chromium() is None:
-    pytest.skip("no Chromium (apt-get install chromium): the viewer check did not run",
-                allow_module_level=True)
+    unavailable("no Chromium (apt-get install chromium): the viewer check did not run",
+                module_level=True)
 
 
 def test_the_welcome_screen_is_not_taken_for_a_recording():

@@ -11,6 +11,7 @@ import pytest
 import yaml
 from broken import GT, IMU, ROLL, _gap, _late_start, edit, set_cell, shift_time
 from workflow_runs import GRID, REPO, SNAKEMAKE, assert_same_results, run_workflow
+from unavailable import unavailable
 
 from alfa_bench.analysis.detections import (
     INJECTED_RECORDS,
@@ -165,7 +166,7 @@ def test_the_html_report_holds_the_figures_and_tables(runs, corpus):
     from alfa_bench.workflow.report_page import open_report
     from alfa_bench.workflow.viewer import chromium
     if chromium() is None:
-        pytest.skip("no Chromium (apt-get install chromium): the report was not opened")
+        unavailable("no Chromium (apt-get install chromium): the report was not opened")
     view = open_report(work / "report.html", work / "report.png", "Comparison",
                        "results/tables/comparison.html")
     assert "Start here." in view.overview and not view.errors
@@ -185,7 +186,7 @@ def test_the_results_page_opens_on_the_headline(runs):
     from alfa_bench.workflow.report_page import open_index
     from alfa_bench.workflow.viewer import chromium
     if chromium() is None:
-        pytest.skip("no Chromium (apt-get install chromium): the page was not opened")
+        unavailable("no Chromium (apt-get install chromium): the page was not opened")
     view = open_index(page, runs[0] / "index.png")
     comparison = read_table(runs[0] / "results/tables/comparison.csv")
     best = comparison[(comparison["subset"] == "no_emr") & (comparison["rank"] == 1)].iloc[0]
