@@ -2,7 +2,8 @@
 # Run: snakemake all --cores 2   (with ALFA_DIR set, or the archive is downloaded)
 from snakemake.utils import min_version, validate
 
-from alfa_bench.workflow.checks import config_problem, stop
+from alfa_bench.config import config_problem
+from alfa_bench.workflow.checks import stop
 
 min_version("9.0")
 

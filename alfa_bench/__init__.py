@@ -6,7 +6,7 @@ From Python, a detector is scored as the workflow scores its runs::
 
     corpus = ab.load_corpus()                      # ALFA_DIR, the config, or the download
     result = ab.evaluate(MyDetector(), corpus)     # or the name of a config run
-    ab.compare(result)                             # ranked beside results/ of the workflow
+    ab.compare(result, published="results")        # beside the runs of `snakemake all`
 
 The rooms: :mod:`alfa_bench.data` (flights, signals, manifest), :mod:`alfa_bench.methods`
 (the detector contract and the detectors), :mod:`alfa_bench.analysis` (folds,
@@ -15,16 +15,24 @@ figures, recordings, provenance, the paper) and :mod:`alfa_bench.workflow` (what
 the Snakemake rules and scripts use).
 """
 
+from importlib.metadata import PackageNotFoundError, version
+
 from alfa_bench.lazy import lazy_names
+
+try:
+    __version__ = version("alfa-bench")
+except PackageNotFoundError:   # run from sources that were never installed
+    __version__ = "0+unknown"
 
 # each name's module, imported when the name is first used: a workflow job that imports
 # one module of the package pays for no other
 _MODULES = {
-    **dict.fromkeys(["Corpus", "Result", "compare", "evaluate", "load_config", "load_corpus"],
+    **dict.fromkeys(["Corpus", "Result", "compare", "evaluate", "load_corpus", "user_cache"],
                     "alfa_bench.analysis.evaluation"),
+    **dict.fromkeys(["ConfigError", "load_config"], "alfa_bench.config"),
     **dict.fromkeys(["CalibrationError", "Detector", "MaximaThresholds", "NotFittedError",
                      "make_detector"], "alfa_bench.methods"),
 }
 
-__all__ = sorted(_MODULES)
+__all__ = ["__version__", *sorted(_MODULES)]
 __getattr__, __dir__ = lazy_names(__name__, _MODULES)

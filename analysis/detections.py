@@ -328,6 +328,8 @@ def detection_record(method: str, spec: dict, detector: Detector, flight: Flight
         "flight": flight.id,
         "method": method,
         "detector": spec["detector"],
+        # a detector of a script or notebook: which code scored (methods.source_digest)
+        **({"detector_source": spec["source"]} if "source" in spec else {}),
         "role": spec.get("role", "method"),
         # whether it reads what the fault emulation writes: from its signals, never set
         "reads_actuators": reads_actuators(detector.signals()),

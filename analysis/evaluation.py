@@ -4,7 +4,7 @@
 
     corpus = ab.load_corpus()                      # ALFA_DIR, the config, or the download
     result = ab.evaluate(MyDetector(), corpus)     # or the name of a config run
-    ab.compare(result)                             # ranked beside results/ of the workflow
+    ab.compare(result, published="results")        # beside the runs of `snakemake all`
 
 :func:`load_corpus` finds the flights as the workflow does and parses each once into a
 cache of the workflow's own format; :func:`evaluate` fits a calibrated detector per
@@ -17,6 +17,7 @@ beside a workflow's published runs on common ground, as ``comparison.csv`` does.
 from __future__ import annotations
 
 import hashlib
+import json
 import logging
 import os
 from collections import ChainMap
@@ -25,9 +26,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
-import yaml
 from threadpoolctl import threadpool_limits
 
+from alfa_bench.config import load_config
 from alfa_bench.data import (
     FAILURE_COLUMNS,
     Flight,
@@ -41,37 +42,22 @@ from alfa_bench.data import (
 from alfa_bench.data.cache import cache_path
 from alfa_bench.data.flight import entries
 from alfa_bench.data.manifest import flight_sha256
-from alfa_bench.methods import Detector, Trace, detector_name, make_detector
+from alfa_bench.methods import (
+    Detector,
+    Trace,
+    detector_name,
+    make_detector,
+    source_digest,
+)
 from alfa_bench.outputs.tables import comparison_table, failures_table
 
 from .detections import detect_all, read_failures, read_records
 from .per_flight import per_flight_table
 
-__all__ = ["Corpus", "Result", "compare", "evaluate", "load_config", "load_corpus"]
+__all__ = ["SCORING_SETTINGS", "Corpus", "Result", "compare", "evaluate", "load_corpus",
+           "user_cache"]
 
 log = logging.getLogger(__name__)
-
-#: the workflow's config, beside the sources of this checkout
-_REPO_CONFIG = Path(__file__).resolve().parent.parent / "config" / "config.yaml"
-
-
-def load_config(path: str | os.PathLike | None = None) -> dict:
-    """The workflow config at ``path`` (default: ``config/config.yaml`` of the working
-    directory, else of this checkout), checked against its schema."""
-    import jsonschema
-
-    if path is None:
-        here = Path("config/config.yaml")
-        path = here if here.is_file() else _REPO_CONFIG
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"no workflow config at {path}: pass config= the path of "
-                                "a config.yaml (the repository's config/config.yaml)")
-    config = yaml.safe_load(path.read_text())
-    schema = yaml.safe_load((path.parent / "schema.yaml").read_text())
-    jsonschema.validate(config, schema)
-    return config
-
 
 @dataclass(frozen=True)
 class Corpus:
@@ -128,25 +114,39 @@ class _Lazy(Mapping):
         return len(self.names)
 
 
+def user_cache() -> Path:
+    """The user's cache folder of alfa-bench (``$XDG_CACHE_HOME/alfa-bench``, by default
+    ``~/.cache/alfa-bench``): parsed flights, and the download when the workflow's
+    config does not say where."""
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "alfa-bench"
+
+
 def _default_cache(processed: Path) -> Path:
     key = hashlib.blake2b(str(processed.resolve()).encode(), digest_size=8).hexdigest()
-    root = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
-    return root / "alfa-bench" / key
+    return user_cache() / key
 
 
 def load_corpus(alfa_dir: str | os.PathLike | None = None, *, config: dict | None = None,
                 cache: str | os.PathLike | None = None) -> Corpus:
     """The flights of ``alfa_dir`` (default: found as the workflow finds them:
     ``ALFA_DIR``, else the config's ``alfa_dir``, else the official archive, downloaded
-    and verified), parsed once into ``cache`` (default: a folder per ALFA copy under
-    ``~/.cache/alfa-bench``). A later call parses again only if a flight's files changed
-    (their SHA-256 is the manifest's key)."""
+    and verified into the user's cache, :func:`user_cache`, never the working folder),
+    parsed once into ``cache`` (default: a folder per ALFA copy under the user's
+    cache). A later call parses again only if a flight's files changed (their SHA-256
+    is the manifest's key). ``config`` is a config dict (default: the one the package
+    ships, :func:`~alfa_bench.config.load_config`)."""
     config = load_config() if config is None else config
-    found = Path(alfa_dir) if alfa_dir is not None else resolve_alfa_dir(config.get("alfa_dir"))
+    if alfa_dir is not None:
+        found, source = Path(alfa_dir), f"load_corpus(alfa_dir={str(alfa_dir)!r})"
+    else:
+        found = resolve_alfa_dir(config.get("alfa_dir"))
+        source = "ALFA_DIR" if os.environ.get("ALFA_DIR") else "the config's alfa_dir"
     if found is None:
         d = config["download"]
-        found = fetch_alfa(d["api"], d["file"], d["dest"], d.get("md5"), d.get("sha256"))
-    processed = processed_dir(found)
+        found = fetch_alfa(d["api"], d["file"], user_cache() / "alfa", d.get("md5"),
+                           d.get("sha256"))
+        source = "the download"
+    processed = processed_dir(found, source)
     cache = Path(cache) if cache is not None else _default_cache(processed)
     manifest_csv, failures_csv = cache / "flights.csv", cache / "load_failures.csv"
     if manifest_csv.is_file() and failures_csv.is_file():
@@ -271,6 +271,8 @@ def evaluate(detector: Detector | str, corpus: Corpus, *, name: str | None = Non
 
             quick_check(detector)
         spec = {"detector": detector_name(detector), "params": detector.get_params()}
+        if ":" in spec["detector"]:        # not registered: "module:Class"
+            spec["source"] = source_digest(type(detector))
         name = name or type(detector).__name__.lower()
     subsets = list(subsets or _subsets(config))
     deadline_s = float(config["scoring"]["deadline_s"] if deadline_s is None else deadline_s)
@@ -317,43 +319,127 @@ def _with_grid(corpus: Corpus) -> tuple[Mapping[str, Flight], pd.DataFrame]:
     return ChainMap(dict(corpus.flights), built), grid
 
 
-def compare(*results: Result, published: str | os.PathLike | None = "results"
-            ) -> pd.DataFrame:
-    """The comparison table (``comparison.csv``'s columns) of ``results`` ranked beside
-    the runs of a workflow's results folder ``published`` (None: the results alone),
-    on common ground: each subset's flights are the published manifest's, and a run
-    that did not score one of them is not ranked. Deadline and subsets are the first
-    result's."""
+#: the config settings every result and the published runs must share to be compared
+SCORING_SETTINGS = {
+    "scoring.deadline_s": ("scoring", "deadline_s"),
+    "subsets": ("subsets",),
+    "primary_subset": ("primary_subset",),
+    "calibration.group_by": ("calibration", "group_by"),
+    "calibration.margin_s": ("calibration", "margin_s"),
+    "stability.pools": ("stability", "pools"),
+    "stability.seed": ("stability", "seed"),
+    "stability.stable": ("stability", "stable"),
+    "stability.interval": ("stability", "interval"),
+}
+
+
+def _setting(config: dict, keys: tuple):
+    for key in keys:
+        config = (config or {}).get(key)
+    return config
+
+
+def compare(*results: Result, published: str | os.PathLike | None = None) -> pd.DataFrame:
+    """The comparison table (``comparison.csv``'s columns) of ``results``, ranked beside
+    the runs of a workflow's results folder ``published`` (the ``results/`` of a
+    ``snakemake all``), or among themselves with ``published`` None.
+
+    Only like is compared with like: every result must be scored with the published
+    run's settings (:data:`SCORING_SETTINGS`: deadline, subsets, grouping, margin,
+    pools and stable share), on its corpus (the same flights, the same files), by the
+    same alfa-bench version; otherwise a :class:`ValueError` names the setting that
+    differs. A run that did not score one of the published flights is not ranked.
+
+    Raises
+    ------
+    FileNotFoundError
+        Where ``published`` holds no workflow results, saying what to run.
+    ValueError
+        Where a result was scored otherwise than the published runs, or two results
+        share a name, or there is nothing to compare."""
     if not results:
         raise ValueError("compare needs at least one Result")
+    names = [res.method for res in results]
+    if len(set(names)) != len(names):
+        raise ValueError(f"two results share a name: {names}; evaluate(..., name=...) "
+                         "another name")
+    if published is None and len(results) < 2:
+        raise ValueError("compare(result) alone has nothing to rank it beside: pass "
+                         "published= the results/ folder of a `snakemake all` run (the "
+                         "README's main job), or two or more results")
     first = results[0]
+    for res in results[1:]:
+        _check_like(first.corpus.config, first.deadline_s, first.subsets,
+                    first.corpus.manifest, res, f"result {first.method!r}", res.method)
     manifest = first.corpus.manifest
     records = [r for res in results for r in res.records]
     failures = [res.failures for res in results]
-    names = [res.method for res in results]
     if published is not None:
-        out = Path(published)
+        out = _published(published)
         manifest = read_manifest(out / "flights.csv")
+        run = json.loads((out / "provenance.json").read_text())["run"]
+        for res in results:
+            _check_like(run["config"], float(run["config"]["scoring"]["deadline_s"]),
+                        _subsets(run["config"]), manifest, res, str(out), res.method,
+                        run["code"]["version"])
         folders = sorted(p for p in (out / "detections").iterdir() if p.is_dir())
         clash = sorted({p.name for p in folders} & set(names))
         if clash:
             raise ValueError(f"{clash} already named in {out}: evaluate(..., name=...) "
                              "another name")
-        _check_same_flights(manifest, results, out)
         records += read_records(folders)
         failures += [failures_table(pd.read_csv(out / "load_failures.csv", dtype=str,
                                                 keep_default_na=False),
                                     read_failures(folders))]
-    if len(set(names)) != len(names):
-        raise ValueError(f"two results share a name: {names}")
     return comparison_table(records, manifest, first.subsets, first.deadline_s,
                             pd.concat(failures, ignore_index=True).drop_duplicates(),
                             *_stable(first.corpus.config))
 
 
-def _check_same_flights(manifest: pd.DataFrame, results, out: Path) -> None:
-    """Each flight of the published ``manifest`` that a result scored must be the same
-    files (SHA-256) in both."""
+def _published(published: str | os.PathLike) -> Path:
+    """The results folder ``published``, checked to hold a workflow's results."""
+    out = Path(published)
+    missing = [n for n in ("flights.csv", "load_failures.csv", "provenance.json",
+                           "detections") if not (out / n).exists()]
+    if missing:
+        raise FileNotFoundError(
+            f"compare(published={str(published)!r}): {out.resolve()} holds no results of a "
+            f"workflow run (no {', '.join(missing)}). What to do: run `snakemake all "
+            "--cores 2` in a checkout (the README's main job) and pass its results/ "
+            "folder, or published=None to rank two or more results among themselves")
+    return out
+
+
+def _check_like(config: dict, deadline_s: float, subsets: list[str], manifest: pd.DataFrame,
+                res: Result, where: str, name: str, version: str | None = None) -> None:
+    """``res`` (named ``name``) scored as ``config``, ``deadline_s`` and ``subsets`` say,
+    on the flights of ``manifest`` (``where`` named them), by alfa-bench ``version``;
+    else the ValueError that names what differs."""
+    mine = res.corpus.config
+    differs = [(k, _setting(mine, keys), _setting(config, keys))
+               for k, keys in SCORING_SETTINGS.items()
+               if _setting(mine, keys) != _setting(config, keys)]
+    if res.deadline_s != deadline_s:
+        differs.append(("deadline_s", res.deadline_s, deadline_s))
+    if list(res.subsets) != list(subsets):
+        differs.append(("subsets", list(res.subsets), list(subsets)))
+    if differs:
+        key, a, b = differs[0]
+        raise ValueError(f"{name} was scored with {key} = {a!r}, {where} with {b!r}: "
+                         "compare runs scored alike (evaluate(..., deadline_s=, subsets=) "
+                         "or a corpus loaded with the same config)")
+    _check_same_flights(manifest, [res], where)
+    if version is not None:
+        from alfa_bench import __version__
+
+        if version != __version__:
+            raise ValueError(f"{where} was made by alfa-bench {version}, {name} by "
+                             f"{__version__}: run the workflow again with this version")
+
+
+def _check_same_flights(manifest: pd.DataFrame, results, out) -> None:
+    """Each result scored the flights of ``manifest`` (from ``out``), the same files
+    (SHA-256) under the same names, and no other."""
     published = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
     for res in results:
         mine = dict(zip(res.corpus.manifest["flight"], res.corpus.manifest["sha256"],
@@ -362,3 +448,8 @@ def _check_same_flights(manifest: pd.DataFrame, results, out: Path) -> None:
         if other:
             raise ValueError(f"{res.method} scored other files than {out} under the same "
                              f"flight names, e.g. {other[0]}: compare runs of one ALFA copy")
+        apart = sorted(set(mine) ^ set(published))
+        if apart:
+            raise ValueError(f"{res.method} and {out} scored other corpora ({len(mine)} and "
+                             f"{len(published)} flights; {apart[0]} is in one only): "
+                             "compare runs of one ALFA copy")

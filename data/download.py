@@ -49,12 +49,14 @@ def resolve_alfa_dir(configured: str | os.PathLike | None = None) -> Path | None
     return Path(value) if value else None
 
 
-def processed_dir(alfa_dir: str | os.PathLike) -> Path:
-    """``alfa_dir/processed``, checked to exist."""
+def processed_dir(alfa_dir: str | os.PathLike,
+                  source: str = "ALFA_DIR (or alfa_dir in the config)") -> Path:
+    """``alfa_dir/processed``, checked to exist; ``source`` is what named ``alfa_dir``,
+    for the error."""
     processed = Path(alfa_dir) / "processed"
     if not processed.is_dir():
-        raise MissingFolderError(f"{processed} does not exist: ALFA_DIR (or alfa_dir in the "
-                            "config) must name the folder that holds processed/")
+        raise MissingFolderError(f"{processed} does not exist: {source} must name the "
+                                 "folder that holds ALFA's processed/")
     return processed
 
 

@@ -30,6 +30,7 @@ from .base import (
     labelled_segments,
     run_detector,
     skipped_channels,
+    source_digest,
     training_segments,
 )
 from .extremes import MaximaThresholds
@@ -38,7 +39,7 @@ __all__ = ["BUILTIN", "BUILTIN_ENTRIES", "DEFAULT_RATE_HZ", "PLUGIN_GROUP", "REG
            "CalibrationError", "Detector", "Fork", "Labelled", "MaximaThresholds",
            "NotFittedError", "PairDetector", "StaleStateError", "Trace", "clone", "detector_name",
            "fault_free_segments", "fit_token", "forks", "labelled_segments", "make_detector",
-           "plugins", "run_detector", "skipped_channels", "training_segments"]
+           "plugins", "run_detector", "skipped_channels", "source_digest", "training_segments"]
 
 #: the entry-point group third-party detectors register under
 PLUGIN_GROUP = "alfa_bench.methods"

@@ -67,7 +67,8 @@ from alfa_bench.data import Flight, Sampled, not_measured, sample
 __all__ = ["DEFAULT_RATE_HZ", "CalibrationError", "Detector", "Fork", "Labelled",
            "NotFittedError", "PairDetector", "StaleStateError", "Trace", "clone",
            "fault_free_segments", "fit_token", "forks", "json_ready", "labelled_segments",
-           "learned_state", "run_detector", "skipped_channels", "training_segments"]
+           "learned_state", "run_detector", "skipped_channels", "source_digest",
+           "training_segments"]
 
 log = logging.getLogger(__name__)
 
@@ -166,6 +167,24 @@ def json_ready(value):
     if hasattr(value, "__dict__"):
         return json_ready(vars(value))
     return repr(value)
+
+
+def source_digest(cls: type) -> str:
+    """A digest of the code of ``cls`` and of its bases outside alfa-bench: the source
+    where it can be read, else each function's bytecode and constants (a class typed
+    into a notebook)."""
+    h = hashlib.blake2b(digest_size=16)
+    for c in cls.__mro__:
+        if c.__module__.split(".")[0] in ("alfa_bench", "builtins", "abc"):
+            continue
+        try:
+            h.update(inspect.getsource(c).encode())
+        except (OSError, TypeError):
+            for name, f in sorted(vars(c).items()):
+                code = getattr(f, "__code__", None)
+                if code is not None:
+                    h.update(name.encode() + code.co_code + repr(code.co_consts).encode())
+    return h.hexdigest()
 
 
 def clone(detector: Detector) -> Detector:

@@ -34,3 +34,16 @@ def test_every_local_link_resolves():
                     doc.parent / target).exists():
                 missing.append(f"{doc.relative_to(REPO)} -> {target}")
     assert not missing, missing
+
+
+def test_the_python_guide_lists_every_signal_with_its_unit_topic_and_honesty():
+    from alfa_bench.data import SIGNALS
+
+    rows = {line.split("|")[1].strip().strip("`"): line
+            for line in (REPO / "docs/python.md").read_text().splitlines()
+            if line.startswith("| `")}
+    for name, signal in SIGNALS.items():
+        assert name in rows, name
+        cells = [c.strip() for c in rows[name].split("|")[1:-1]]
+        assert cells[1] == signal.unit and f"`{signal.topic}`" in cells[2], name
+        assert cells[4].startswith("**no**") == (signal.kind == "actuator"), name

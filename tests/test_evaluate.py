@@ -124,6 +124,38 @@ def test_evaluate_scores_a_three_member_detector_and_compare_ranks_it(local):
         assert list(ranked["rank"]) == list(range(1, len(ranked) + 1))
     with pytest.raises(ValueError, match="share a name"):
         ab.compare(result, result, published=None)
+    assert len(result.records[0]["detector_source"]) == 32
+    assert "detector_source" not in other.records[0]
+
+
+def test_compare_compares_like_with_like_and_says_what_to_run(local, tmp_path):
+    mine, other = ab.evaluate(RollError(), local), ab.evaluate("residual_bank", local)
+    with pytest.raises(ValueError, match="nothing to rank it beside.*published="):
+        ab.compare(mine)
+    with pytest.raises(FileNotFoundError, match="snakemake all"):
+        ab.compare(mine, published=tmp_path / "results")
+    late = ab.evaluate(RollError(), local, name="late", deadline_s=2.0)
+    with pytest.raises(ValueError, match="residual_bank was scored with deadline_s = 5.0, "
+                                         "result 'late' with 2.0"):
+        ab.compare(late, other)
+    fewer = evaluation.Corpus(local.processed, local.manifest.iloc[1:], local.failures,
+                              local.config, local.cache)
+    with pytest.raises(ValueError, match="other corpora"):
+        ab.compare(ab.evaluate(RollError(), fewer, name="fewer"), other)
+
+
+def test_a_path_or_config_given_is_named_in_the_error(tmp_path):
+    from alfa_bench.data import MissingFolderError
+
+    with pytest.raises(MissingFolderError, match=r"load_corpus\(alfa_dir="):
+        ab.load_corpus(tmp_path, cache=tmp_path / "cache")
+    bad = tmp_path / "config.yaml"
+    bad.write_text((REPO / "config/config.yaml").read_text().replace(
+        "scoring:\n  deadline_s", "scoring:\n  dedline_s"))
+    with pytest.raises(ab.ConfigError, match=r"unknown key 'dedline_s' under scoring "
+                                             rf"\(in {bad}\). Did you mean 'deadline_s'"):
+        ab.load_config(bad)
+    assert ab.load_config()["scoring"]["deadline_s"] > 0
 
 
 def test_evaluate_fits_clones_and_leaves_the_callers_detector_as_it_was(local):

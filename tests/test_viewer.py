@@ -6,7 +6,6 @@ import urllib.request
 
 import numpy as np
 import pytest
-
 from unavailable import require_module, unavailable
 
 from alfa_bench.data import load_flight

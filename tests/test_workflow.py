@@ -10,8 +10,8 @@ from pathlib import Path
 import pytest
 import yaml
 from broken import GT, IMU, ROLL, _gap, _late_start, edit, set_cell, shift_time
-from workflow_runs import GRID, REPO, SNAKEMAKE, assert_same_results, run_workflow
 from unavailable import unavailable
+from workflow_runs import GRID, REPO, SNAKEMAKE, assert_same_results, run_workflow
 
 from alfa_bench.analysis.detections import (
     INJECTED_RECORDS,

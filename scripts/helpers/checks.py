@@ -1,62 +1,21 @@
 """What the workflow checks before any job runs, ending on one message that says what
-to do: the config against its schema, and the ALFA folder it was pointed at."""
+to do: the ALFA folder it was pointed at (the config against its schema is
+:func:`alfa_bench.config.config_problem`, which the Python route shares)."""
 
 from __future__ import annotations
 
-import difflib
 import sys
 from pathlib import Path
 
-import yaml
-
 from alfa_bench.data.flight import entries, not_a_flight
 
-__all__ = ["alfa_dir_problem", "config_problem", "stop"]
+__all__ = ["alfa_dir_problem", "failure_message", "stop"]
 
 
 def stop(message: str) -> None:
     """End the run on ``message``, its last lines, without a traceback."""
     print(f"\n{message}", file=sys.stderr)
     sys.exit(1)
-
-
-def _found_in(files, path: list) -> str:
-    """Which of the config ``files`` sets the key at ``path`` (the last one wins)."""
-    found = None
-    for f in files:
-        node = yaml.safe_load(Path(f).read_text()) if Path(f).is_file() else None
-        for key in path:
-            node = node.get(key) if isinstance(node, dict) and key in node else None
-            if node is None:
-                break
-        else:
-            found = f
-    return f"in {found}" if found else "given with --config"
-
-
-def config_problem(config: dict, schema_path: str | Path, files) -> str | None:
-    """The first way ``config`` breaks its schema, in words: the key and where it is
-    set (which of the config ``files``), and for an unknown key the keys allowed
-    there, the nearest first; None if it does not."""
-    import jsonschema
-    from jsonschema.exceptions import best_match
-
-    schema = yaml.safe_load(Path(schema_path).read_text())
-    error = best_match(jsonschema.Draft202012Validator(schema).iter_errors(config))
-    if error is None:
-        return None
-    path = list(error.absolute_path)
-    if error.validator == "additionalProperties":
-        allowed = sorted(error.schema.get("properties", {}))
-        key = sorted(set(error.instance) - set(allowed))[0]
-        near = difflib.get_close_matches(key, allowed, n=1)
-        under = ".".join(map(str, path)) or "the top level"
-        return (f"config: unknown key {key!r} under {under} ({_found_in(files, [*path, key])})."
-                + (f" Did you mean {near[0]!r}?" if near else "")
-                + f"\nAllowed there: {', '.join(allowed)}.")
-    name = ".".join(map(str, path)) or "(top level)"
-    message = error.message if len(error.message) < 200 else error.message[:200] + " ..."
-    return f"config {name}: {message} ({_found_in(files, path)})."
 
 
 def _entries(n: int) -> str:
