@@ -3,7 +3,7 @@
 from snakemake.utils import min_version, validate
 
 from alfa_bench.config import config_problem
-from alfa_bench.workflow.checks import stop
+from alfa_bench.workflow.preflight import stop
 
 min_version("9.0")
 

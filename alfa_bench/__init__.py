@@ -28,7 +28,7 @@ except PackageNotFoundError:   # run from sources that were never installed
 # one module of the package pays for no other
 _MODULES = {
     **dict.fromkeys(["Corpus", "Result", "compare", "evaluate", "load_corpus", "user_cache"],
-                    "alfa_bench.analysis.evaluation"),
+                    "alfa_bench.evaluation"),
     **dict.fromkeys(["ConfigError", "load_config"], "alfa_bench.config"),
     **dict.fromkeys(["CalibrationError", "Detector", "MaximaThresholds", "NotFittedError",
                      "make_detector"], "alfa_bench.methods"),

@@ -43,7 +43,7 @@ import pandas as pd
 
 from alfa_bench.data import AlfaDataError, Flight
 from alfa_bench.methods.physics import BASELINE_S, FEATURES, features
-from alfa_bench.outputs.render import fmt, markdown
+from alfa_bench.render import fmt, markdown
 
 __all__ = ["BOOTSTRAP", "auc_interval", "ceiling_markdown", "ceiling_table"]
 

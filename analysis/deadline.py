@@ -13,19 +13,16 @@ so no detector is re-run.
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pandas as pd
 
 from alfa_bench.data import subset_flights
-from alfa_bench.outputs.figures import BLOCK_STYLES, colors, plt, save
-from alfa_bench.outputs.render import fmt, markdown
-from alfa_bench.outputs.tables import BLOCKS, block
+from alfa_bench.render import fmt, markdown
 
+from .blocks import BLOCKS, block
 from .scoring import wilson_interval
 
-__all__ = ["deadline_figure", "deadline_markdown", "deadline_table", "false_alarm_time"]
+__all__ = ["deadline_markdown", "deadline_table", "false_alarm_time"]
 
 
 def false_alarm_time(record: dict) -> tuple[int, float]:
@@ -96,28 +93,3 @@ def deadline_markdown(table: pd.DataFrame, shown=(1.0, 2.0, 5.0, 10.0, 30.0)) ->
         sections.append((f"Subset `{subset}`: detection rate against the deadline", header,
                          rows))
     return markdown(sections)
-
-
-def deadline_figure(table: pd.DataFrame, subset: str, path: str | Path) -> None:
-    """Detection rate against the deadline, one curve per run (honest solid, marked
-    dashed, reference dotted); the legend gives the false alarms per hour."""
-    data = table[table["subset"] == subset]
-    methods = list(dict.fromkeys(data["method"]))
-    palette = colors(methods)
-    fig, ax = plt.subplots(figsize=(8.5, 5.0), layout="constrained")
-    for m in methods:
-        d = data[data["method"] == m].sort_values("deadline_s")
-        style = BLOCK_STYLES[d["block"].iloc[0]]
-        fa = d["false_alarms_per_hour"].iloc[0]
-        ax.plot(d["deadline_s"], d["detection_rate"], color=palette[m], marker=".", **style,
-                label=f"{m} ({d['block'].iloc[0]}; {fmt(fa, digits=1)} false alarms/h)")
-    ax.set_xscale("log")
-    ax.set_xlabel("detection deadline after onset (s)")
-    ax.set_ylabel("faults detected within the deadline (share)")
-    ax.set_ylim(-0.02, 1.02)
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7, loc="upper left")
-    n = int(data["fault_flights"].iloc[0]) if len(data) else 0
-    ax.set_title(f"Detection rate against deadline, subset '{subset}' ({n} fault flights)",
-                 fontsize=10)
-    save(fig, path)

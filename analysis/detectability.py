@@ -18,17 +18,16 @@ it.
 from __future__ import annotations
 
 from collections.abc import Iterable
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from alfa_bench.outputs.figures import colors, plt, save
-from alfa_bench.outputs.render import fmt, markdown
+from alfa_bench.render import fmt, markdown
 
 from .scoring import flight_outcome
 
-__all__ = ["detectability_figure", "detectability_markdown", "detectability_table"]
+__all__ = ["EMPTY", "by_fault", "detectability_markdown", "detectability_table",
+           "fault_name"]
 
 _KEYS = ["method", "sensor", "kind", "magnitude"]
 _COUNTS = ["flights", "detected", "alarmed_before_onset", "missed", "detection_rate",
@@ -72,7 +71,7 @@ def detectability_table(records: Iterable[dict], manifest: pd.DataFrame,
     return pd.DataFrame(out, columns=[*_KEYS, *_COUNTS])
 
 
-def _by_fault(table: pd.DataFrame) -> pd.DataFrame:
+def by_fault(table: pd.DataFrame) -> pd.DataFrame:
     """Over all sensors: per method and fault, detected share and mean time."""
     g = table.groupby(["method", "kind", "magnitude"], sort=False)
     out = g[["flights", "detected", "alarmed_before_onset"]].sum()
@@ -87,7 +86,7 @@ def _by_fault(table: pd.DataFrame) -> pd.DataFrame:
     return out.reset_index()
 
 
-def _fault_name(kind: str, magnitude: float) -> str:
+def fault_name(kind: str, magnitude: float) -> str:
     if kind in ("stuck", "zero"):
         return kind
     return f"{kind} {100 * magnitude:g} %"
@@ -99,13 +98,13 @@ def detectability_markdown(table: pd.DataFrame) -> str:
     all faults."""
     if table.empty:
         return EMPTY + "\n"
-    by = _by_fault(table)
+    by = by_fault(table)
     methods = list(dict.fromkeys(by["method"]))
     faults = list(dict.fromkeys(zip(by["kind"], by["magnitude"], strict=True)))
     idx = by.set_index(["method", "kind", "magnitude"])
     rows = []
     for kind, m in faults:
-        cells = [_fault_name(kind, m)]
+        cells = [fault_name(kind, m)]
         for method in methods:
             r = idx.loc[(method, kind, m)]
             cells.append(f"{fmt(float(r['detection_rate']), True, 0)} "
@@ -121,47 +120,3 @@ def detectability_markdown(table: pd.DataFrame) -> str:
          "over all sensors",
          ["fault", *methods], rows),
         ("Detection rate % per sensor, over all faults", ["sensor", *methods], sensor_rows)])
-
-
-def detectability_figure(table: pd.DataFrame, path: str | Path) -> None:
-    """Detection rate against fault size (drift, scale) per method, and for the
-    faults without a size (stuck, zero) and those beyond the paper (noise, ramp)."""
-    if table.empty:
-        fig = plt.figure(figsize=(13, 1.5))
-        fig.text(0.5, 0.5, EMPTY, ha="center", va="center", wrap=True)
-        save(fig, path)
-        return
-    by = _by_fault(table)
-    methods = list(dict.fromkeys(by["method"]))
-    palette = colors(methods)
-    fig, axes = plt.subplots(1, 3, figsize=(13, 3.8), layout="constrained")
-    for ax, kind, size, label in [
-            (axes[0], "drift", lambda m: m, "drift (fraction of the sensor's range)"),
-            (axes[1], "scale", lambda m: 1 - m, "lost output, 1 - scale factor")]:
-        for method in methods:
-            d = by[(by["method"] == method) & (by["kind"] == kind)]
-            x = size(d["magnitude"].to_numpy())
-            order = np.argsort(x)
-            ax.plot(x[order], d["detection_rate"].to_numpy()[order], "o-", label=method,
-                    color=palette[method])
-            ax.plot(x[order], d["chance_rate"].to_numpy()[order], ":", color=palette[method],
-                    lw=1)
-        ax.set_xlabel(label)
-        ax.set_title(kind)
-    other = [f for f in dict.fromkeys(zip(by["kind"], by["magnitude"], strict=True))
-             if f[0] not in ("drift", "scale")]
-    width = 0.8 / max(len(methods), 1)
-    for i, method in enumerate(methods):
-        d = by[by["method"] == method].set_index(["kind", "magnitude"])
-        axes[2].bar(np.arange(len(other)) + i * width,
-                    [d.loc[f, "detection_rate"] for f in other], width, color=palette[method])
-    axes[2].set_xticks(np.arange(len(other)) + 0.4 - width / 2,
-                       [_fault_name(*f) for f in other], fontsize=8)
-    axes[2].set_title("other faults")
-    for ax in axes:
-        ax.set_ylim(-0.03, 1.03)
-        ax.grid(alpha=0.3)
-    axes[0].set_ylabel("detection rate (dotted: chance rate)")
-    axes[0].legend(fontsize=7)
-    fig.suptitle("Detectability of injected sensor faults (all sensors, onsets, flights)")
-    save(fig, path)

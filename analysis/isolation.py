@@ -25,7 +25,7 @@ import pandas as pd
 from alfa_bench.data import SIGNALS
 from alfa_bench.data.inject import SENSORS
 from alfa_bench.methods import Trace
-from alfa_bench.outputs.render import fmt, markdown
+from alfa_bench.render import fmt, markdown
 
 __all__ = ["MISSED", "SENSOR_ACTUATOR", "confusion", "isolate", "isolation_markdown",
            "isolation_rows", "measured_sensor", "named_class", "names_class"]

@@ -68,8 +68,9 @@ from numpy.lib.stride_tricks import sliding_window_view
 from scipy.stats import binom
 
 from alfa_bench.data import SIGNALS, AlfaDataError, Flight, not_measured, series, subset_flights
-from alfa_bench.outputs.render import fmt, markdown
-from alfa_bench.outputs.tables import FAULT_ORDER
+from alfa_bench.render import fmt, markdown
+
+from .blocks import FAULT_ORDER
 
 __all__ = ["StepTest", "audit_note", "flat_spell_starts", "leaking_flights", "leakage_markdown",
            "leakage_table", "step_ranks", "step_sizes"]

@@ -38,9 +38,9 @@ import pandas as pd
 
 from alfa_bench.data import subset_flights
 from alfa_bench.methods import Trace
-from alfa_bench.outputs.render import fmt, markdown
-from alfa_bench.outputs.tables import BLOCK_MARKS, BLOCKS, block
+from alfa_bench.render import fmt, markdown
 
+from .blocks import BLOCK_MARKS, BLOCKS, block
 from .isolation import named_class, names_class
 from .scoring import flight_outcome
 from .stability import survival

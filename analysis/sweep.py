@@ -26,8 +26,8 @@ import pandas as pd
 
 from alfa_bench.data import subset_flights
 from alfa_bench.methods import Trace
-from alfa_bench.outputs.tables import block
 
+from .blocks import block
 from .scoring import flight_outcome, summarize
 
 __all__ = ["DEFAULT_SCALES", "flight_curves", "ratio", "sweep_table"]

@@ -1,5 +1,5 @@
 """Small synthetic flights in ALFA's on-disk format: what the tests, the detector
-checks (:mod:`alfa_bench.methods.checks`) and a plugin's own tests run on.
+checks (:mod:`alfa_bench.methods.contract`) and a plugin's own tests run on.
 
 Roll and pitch follow a known first-order ARX law from their commands, airspeed
 another, and the body rates (``imu-data_raw``, 10 Hz) a known law from the servo

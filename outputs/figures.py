@@ -4,6 +4,10 @@
   of fault-free flight) and mean detection time against false alarms per hour, every
   method on one set of axes, the configured operating point marked.
 - :func:`detection_time_figure`: per method, detection times by fault class.
+- :func:`deadline_figure`: detection rate against the detection deadline
+  (:mod:`alfa_bench.analysis.deadline`).
+- :func:`detectability_figure`: detection rate of the injected sensor faults against
+  their size (:mod:`alfa_bench.analysis.detectability`).
 - the per-flight figures, one small panel per method of its score-to-threshold ratio
   around the onset, are in :mod:`.flight_figures`.
 
@@ -21,9 +25,12 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from .tables import FAULT_ORDER  # noqa: E402
+from alfa_bench.analysis.blocks import FAULT_ORDER  # noqa: E402
+from alfa_bench.analysis.detectability import EMPTY, by_fault, fault_name  # noqa: E402
+from alfa_bench.render import fmt  # noqa: E402
 
-__all__ = ["BLOCK_STYLES", "DPI", "colors", "detection_time_figure", "save", "sweep_figure"]
+__all__ = ["BLOCK_STYLES", "DPI", "colors", "deadline_figure", "detectability_figure",
+           "detection_time_figure", "save", "sweep_figure"]
 
 #: the resolution of every figure, dots per inch
 DPI = 110
@@ -135,4 +142,73 @@ def detection_time_figure(records: list[dict], flights: list[str], deadline_s: f
     fig.suptitle(f"Detection time by fault class, scored with the {deadline_s:g} s deadline "
                  "(bar = median; label = detected in time / flights, + late: x, detected "
                  "by the paper's rule only)", fontsize=9)
+    save(fig, path)
+
+
+def deadline_figure(table: pd.DataFrame, subset: str, path: str | Path) -> None:
+    """Detection rate against the deadline, one curve per run (honest solid, marked
+    dashed, reference dotted); the legend gives the false alarms per hour."""
+    data = table[table["subset"] == subset]
+    methods = list(dict.fromkeys(data["method"]))
+    palette = colors(methods)
+    fig, ax = plt.subplots(figsize=(8.5, 5.0), layout="constrained")
+    for m in methods:
+        d = data[data["method"] == m].sort_values("deadline_s")
+        style = BLOCK_STYLES[d["block"].iloc[0]]
+        fa = d["false_alarms_per_hour"].iloc[0]
+        ax.plot(d["deadline_s"], d["detection_rate"], color=palette[m], marker=".", **style,
+                label=f"{m} ({d['block'].iloc[0]}; {fmt(fa, digits=1)} false alarms/h)")
+    ax.set_xscale("log")
+    ax.set_xlabel("detection deadline after onset (s)")
+    ax.set_ylabel("faults detected within the deadline (share)")
+    ax.set_ylim(-0.02, 1.02)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7, loc="upper left")
+    n = int(data["fault_flights"].iloc[0]) if len(data) else 0
+    ax.set_title(f"Detection rate against deadline, subset '{subset}' ({n} fault flights)",
+                 fontsize=10)
+    save(fig, path)
+
+
+def detectability_figure(table: pd.DataFrame, path: str | Path) -> None:
+    """Detection rate against fault size (drift, scale) per method, and for the
+    faults without a size (stuck, zero) and those beyond the paper (noise, ramp)."""
+    if table.empty:
+        fig = plt.figure(figsize=(13, 1.5))
+        fig.text(0.5, 0.5, EMPTY, ha="center", va="center", wrap=True)
+        save(fig, path)
+        return
+    by = by_fault(table)
+    methods = list(dict.fromkeys(by["method"]))
+    palette = colors(methods)
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.8), layout="constrained")
+    for ax, kind, size, label in [
+            (axes[0], "drift", lambda m: m, "drift (fraction of the sensor's range)"),
+            (axes[1], "scale", lambda m: 1 - m, "lost output, 1 - scale factor")]:
+        for method in methods:
+            d = by[(by["method"] == method) & (by["kind"] == kind)]
+            x = size(d["magnitude"].to_numpy())
+            order = np.argsort(x)
+            ax.plot(x[order], d["detection_rate"].to_numpy()[order], "o-", label=method,
+                    color=palette[method])
+            ax.plot(x[order], d["chance_rate"].to_numpy()[order], ":", color=palette[method],
+                    lw=1)
+        ax.set_xlabel(label)
+        ax.set_title(kind)
+    other = [f for f in dict.fromkeys(zip(by["kind"], by["magnitude"], strict=True))
+             if f[0] not in ("drift", "scale")]
+    width = 0.8 / max(len(methods), 1)
+    for i, method in enumerate(methods):
+        d = by[by["method"] == method].set_index(["kind", "magnitude"])
+        axes[2].bar(np.arange(len(other)) + i * width,
+                    [d.loc[f, "detection_rate"] for f in other], width, color=palette[method])
+    axes[2].set_xticks(np.arange(len(other)) + 0.4 - width / 2,
+                       [fault_name(*f) for f in other], fontsize=8)
+    axes[2].set_title("other faults")
+    for ax in axes:
+        ax.set_ylim(-0.03, 1.03)
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("detection rate (dotted: chance rate)")
+    axes[0].legend(fontsize=7)
+    fig.suptitle("Detectability of injected sensor faults (all sensors, onsets, flights)")
     save(fig, path)

@@ -15,8 +15,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from .render import fmt
-from .tables import FAULT_ORDER, SUBSET_NOTES
+from alfa_bench.analysis.blocks import FAULT_ORDER
+from alfa_bench.render import fmt
+
+from .tables import SUBSET_NOTES
 
 __all__ = ["index_html"]
 

@@ -60,11 +60,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from alfa_bench.analysis.blocks import FAULT_ORDER
 from alfa_bench.analysis.reference import ICRA2019_SUMMARY
 from alfa_bench.data import SIGNALS
+from alfa_bench.render import latex_escape
 
-from .render import latex_escape
-from .tables import FAULT_ORDER, SIGNIFICANCE
+from .tables import SIGNIFICANCE
 
 __all__ = ["latex_macros", "latex_keys", "paper_numbers", "render_markdown", "sensor_numbers"]
 

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from .tables import block
+from alfa_bench.analysis.blocks import block
 
 __all__ = ["records_table", "write_parquet"]
 

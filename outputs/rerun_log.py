@@ -34,11 +34,10 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
+from alfa_bench.analysis.provenance import code_version
 from alfa_bench.analysis.sweep import ratio
 from alfa_bench.data import SIGNALS, AlfaDataError, Flight, series
 from alfa_bench.methods import Trace
-
-from .provenance import code_version
 
 __all__ = ["TIMELINE", "blueprint", "merge_rerun_log", "signal_group", "write_rerun_log",
            "write_rerun_part"]

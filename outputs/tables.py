@@ -31,39 +31,22 @@ import math
 
 import pandas as pd
 
+from alfa_bench.analysis.blocks import BLOCK_MARKS, BLOCKS, FAULT_ORDER, block
 from alfa_bench.analysis.isolation import names_class
 from alfa_bench.analysis.reference import ICRA2019_BY_FAULT, ICRA2019_NAME, ICRA2019_SUMMARY
 from alfa_bench.analysis.scoring import mcnemar_exact, score_records
 from alfa_bench.analysis.stability import pool_summaries, stability_table
-from alfa_bench.data import FAILURE_COLUMNS, FAULT_CLASSES, subset_flights
+from alfa_bench.data import FAILURE_COLUMNS, subset_flights
+from alfa_bench.render import Section, fmt, latex_tables, markdown
 
-from .render import Section, fmt, latex_tables, markdown
-
-__all__ = ["BLOCKS", "BLOCK_MARKS", "FAULT_ORDER", "SIGNIFICANCE", "block", "by_fault_latex",
+__all__ = ["SIGNIFICANCE", "by_fault_latex",
            "by_fault_markdown", "by_fault_table", "comparison_latex", "comparison_markdown",
            "comparison_notes", "comparison_table", "configurations", "failures_table",
            "refit_markdown", "stability_markdown", "summary_latex", "summary_markdown",
            "summary_table", "unscored_notes"]
 
-#: ALFA's fault classes in the tables' order (the injected sensor faults are scored apart)
-FAULT_ORDER = tuple(c for c in FAULT_CLASSES if c != "sensor")
-
-#: the blocks of runs, in the order the tables list them
-BLOCKS = ("honest", "reads actuators", "reference")
-#: what a section title adds to a run of each block
-BLOCK_MARKS = {"honest": "", "reads actuators": " (MARKED: reads actuators)",
-               "reference": " (reference)"}
-
 #: the level below which the exact McNemar test tells two runs apart
 SIGNIFICANCE = 0.05
-
-
-def block(record: dict) -> str:
-    """The block of a run, from its detection record: a reference by its role, else
-    by whether it reads a signal the fault emulation writes."""
-    if record.get("role") == "reference":
-        return "reference"
-    return "reads actuators" if record.get("reads_actuators") else "honest"
 
 
 def failures_table(load: pd.DataFrame, per_method: list[pd.DataFrame]) -> pd.DataFrame:

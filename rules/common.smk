@@ -5,7 +5,7 @@ from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
 
-from alfa_bench.workflow.checks import alfa_dir_problem, failure_message, stop
+from alfa_bench.workflow.preflight import alfa_dir_problem, failure_message, stop
 from alfa_bench.workflow.dependencies import module_sources
 from alfa_bench.workflow.resources import count_flights, job_resources
 from alfa_bench.outputs.provenance import RUN_FILE

@@ -22,7 +22,7 @@ rule rerun_logs:
 
 
 # The README's picture of a recording in rerun's web viewer, taken in headless Chromium
-# (scripts/helpers/viewer.py). Refreshed by this explicit target, never by `all`: it writes a
+# (workflow/viewer.py). Refreshed by this explicit target, never by `all`: it writes a
 # tracked file, and needs Chromium.
 rule viewer_screenshot:
     input:

@@ -3,9 +3,10 @@
 from pathlib import Path
 
 from alfa_bench.analysis.ceiling import ceiling_markdown, ceiling_table
+from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.data import load_cached, read_manifest, subset_flights
-from alfa_bench.outputs.provenance import run_provenance, stamp
-from alfa_bench.outputs.render import markdown_html
+from alfa_bench.outputs.provenance import stamp
+from alfa_bench.render import markdown_html
 from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821

@@ -3,11 +3,12 @@ the detection times by fault class."""
 
 from pathlib import Path
 
-from alfa_bench.analysis import read_records
-from alfa_bench.analysis.deadline import deadline_figure, deadline_markdown, deadline_table
+from alfa_bench.analysis.deadline import deadline_markdown, deadline_table
+from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.data import read_manifest, subset_flights
-from alfa_bench.outputs.figures import detection_time_figure
-from alfa_bench.outputs.provenance import run_provenance, stamp
+from alfa_bench.outputs.figures import deadline_figure, detection_time_figure
+from alfa_bench.outputs.provenance import stamp
+from alfa_bench.outputs.records import read_records
 from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821

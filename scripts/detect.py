@@ -8,9 +8,9 @@ import json
 from collections import ChainMap
 from pathlib import Path
 
-from alfa_bench.analysis.detections import write_detections
 from alfa_bench.data import AlfaDataError, load_cached, read_manifest
 from alfa_bench.data.inject import InjectedGrid
+from alfa_bench.outputs.records import write_detections
 from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821

@@ -2,15 +2,12 @@
 
 from pathlib import Path
 
-from alfa_bench.analysis import read_records
-from alfa_bench.analysis.detectability import (
-    detectability_figure,
-    detectability_markdown,
-    detectability_table,
-)
-from alfa_bench.analysis.detections import iter_records
+from alfa_bench.analysis.detectability import detectability_markdown, detectability_table
+from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.data import read_manifest
-from alfa_bench.outputs.provenance import run_provenance, stamp
+from alfa_bench.outputs.figures import detectability_figure
+from alfa_bench.outputs.provenance import stamp
+from alfa_bench.outputs.records import iter_records, read_records
 from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821

@@ -2,9 +2,10 @@
 
 from pathlib import Path
 
+from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.data import read_manifest
 from alfa_bench.outputs.index_page import index_html
-from alfa_bench.outputs.provenance import read_table, run_id, run_provenance
+from alfa_bench.outputs.provenance import read_table, run_id
 from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821

@@ -5,10 +5,11 @@ import logging
 
 import pandas as pd
 
+from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.data import load_cached, read_manifest
 from alfa_bench.data.inject import InjectedGrid
 from alfa_bench.data.manifest import manifest_of, manifest_row
-from alfa_bench.outputs.provenance import run_provenance, stamp
+from alfa_bench.outputs.provenance import stamp
 from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821

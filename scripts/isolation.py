@@ -3,10 +3,11 @@ sensor) and of ALFA's actuator faults (which actuator class)."""
 
 from pathlib import Path
 
-from alfa_bench.analysis.detections import iter_records
 from alfa_bench.analysis.isolation import isolation_markdown, isolation_rows
+from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.data import read_manifest
-from alfa_bench.outputs.provenance import run_provenance, stamp
+from alfa_bench.outputs.provenance import stamp
+from alfa_bench.outputs.records import iter_records
 from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821

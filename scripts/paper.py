@@ -2,9 +2,10 @@
 
 from pathlib import Path
 
+from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.data import read_manifest
 from alfa_bench.outputs.paper import latex_keys, latex_macros, paper_numbers, render_markdown
-from alfa_bench.outputs.provenance import read_table, run_provenance, stamp
+from alfa_bench.outputs.provenance import read_table, stamp
 from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821

@@ -2,11 +2,13 @@
 
 from pathlib import Path
 
-from alfa_bench.analysis import per_flight_markdown, per_flight_table, read_records
-from alfa_bench.analysis.traces import read_traces
+from alfa_bench.analysis import per_flight_markdown, per_flight_table
+from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.data import read_manifest
 from alfa_bench.outputs.parquet import records_table, write_parquet
-from alfa_bench.outputs.provenance import run_provenance, stamp
+from alfa_bench.outputs.provenance import stamp
+from alfa_bench.outputs.records import read_records
+from alfa_bench.outputs.traces import read_traces
 from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821

@@ -1,7 +1,8 @@
 """Snakemake script: the run's provenance, with the SHA-256 of every output."""
 
+from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.data import read_manifest
-from alfa_bench.outputs.provenance import run_provenance, write_run_file
+from alfa_bench.outputs.provenance import write_run_file
 from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821

@@ -5,10 +5,10 @@ import json
 import logging
 from pathlib import Path
 
+from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.data import read_cached, read_manifest
 from alfa_bench.data.cache import cache_path
 from alfa_bench.methods import make_detector
-from alfa_bench.outputs.provenance import run_provenance
 from alfa_bench.outputs.rerun_log import merge_rerun_log
 from alfa_bench.workflow.logs import log_to
 

@@ -2,12 +2,13 @@
 
 from pathlib import Path
 
-from alfa_bench.analysis.detections import count_records
-from alfa_bench.analysis.runtime import runtime_markdown, runtime_table
+from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.data import read_manifest
-from alfa_bench.outputs.provenance import run_provenance, stamp
-from alfa_bench.outputs.render import markdown_html
+from alfa_bench.outputs.provenance import stamp
+from alfa_bench.outputs.records import count_records
+from alfa_bench.render import markdown_html
 from alfa_bench.workflow.logs import log_to
+from alfa_bench.workflow.runtime import runtime_markdown, runtime_table
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])

@@ -3,10 +3,11 @@ pools of each fold, beside the same pools' thresholds alone."""
 
 from pathlib import Path
 
-from alfa_bench.analysis.detections import read_records
+from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.analysis.stability import refit_first_alarms, refit_table
 from alfa_bench.data import load_cached, read_manifest
-from alfa_bench.outputs.provenance import run_provenance, stamp
+from alfa_bench.outputs.provenance import stamp
+from alfa_bench.outputs.records import read_records
 from alfa_bench.outputs.tables import refit_markdown
 from alfa_bench.workflow.logs import log_to
 

@@ -1,12 +1,13 @@
 """Snakemake script: threshold sweeps of every method from its stored traces, as a
 table and a figure."""
 
-from alfa_bench.analysis import read_records
+from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.analysis.sweep import sweep_table
-from alfa_bench.analysis.traces import read_traces
 from alfa_bench.data import read_manifest
 from alfa_bench.outputs.figures import sweep_figure
-from alfa_bench.outputs.provenance import run_provenance, stamp
+from alfa_bench.outputs.provenance import stamp
+from alfa_bench.outputs.records import read_records
+from alfa_bench.outputs.traces import read_traces
 from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821

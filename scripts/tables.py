@@ -5,7 +5,13 @@ from pathlib import Path
 
 import pandas as pd
 
-from alfa_bench.analysis import (
+from alfa_bench.analysis.leakage import audit_note
+from alfa_bench.analysis.provenance import run_provenance
+from alfa_bench.analysis.stability import calibration_table, stability_table
+from alfa_bench.data import read_manifest
+from alfa_bench.outputs.provenance import read_table, stamp
+from alfa_bench.outputs.records import read_failures, read_records
+from alfa_bench.outputs.tables import (
     by_fault_latex,
     by_fault_markdown,
     by_fault_table,
@@ -13,18 +19,13 @@ from alfa_bench.analysis import (
     comparison_markdown,
     comparison_table,
     failures_table,
-    read_failures,
-    read_records,
+    stability_markdown,
     summary_latex,
     summary_markdown,
     summary_table,
+    unscored_notes,
 )
-from alfa_bench.analysis.leakage import audit_note
-from alfa_bench.analysis.stability import calibration_table, stability_table
-from alfa_bench.data import read_manifest
-from alfa_bench.outputs.provenance import read_table, run_provenance, stamp
-from alfa_bench.outputs.render import markdown_html
-from alfa_bench.outputs.tables import stability_markdown, unscored_notes
+from alfa_bench.render import markdown_html
 from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821

@@ -1,7 +1,7 @@
 """The streaming contract, checked for every registered detector and configured run.
 
 A new method is picked up here by its registry line alone. The checks themselves are
-public (:mod:`alfa_bench.methods.checks`), so that a plugin's own tests run the same
+public (:mod:`alfa_bench.methods.contract`), so that a plugin's own tests run the same
 ones (``examples/alfa-cusum``).
 """
 
@@ -10,7 +10,7 @@ from pathlib import Path
 import yaml
 
 from alfa_bench.methods import REGISTRY, make_detector
-from alfa_bench.methods.checks import parametrize_with_checks
+from alfa_bench.methods.contract import parametrize_with_checks
 
 CONFIG = yaml.safe_load((Path(__file__).parent.parent / "config/config.yaml").read_text())
 RUNS = {name: (spec["detector"], spec.get("params", {})) for name, spec in

@@ -1,4 +1,4 @@
-"""The Python route (analysis/evaluation.py): a corpus parsed once, a detector written in
+"""The Python route (alfa_bench/evaluation.py): a corpus parsed once, a detector written in
 three members scored by evaluate() and ranked by compare(), and the workflow's own
 records from evaluate() of a configured run on the real flights."""
 
@@ -11,10 +11,10 @@ import pytest
 from broken import ROLL, edit, set_cell
 
 import alfa_bench as ab
-from alfa_bench.analysis import evaluation
+from alfa_bench import evaluation
 from alfa_bench.analysis.per_flight import per_flight_table
 from alfa_bench.methods import DEFAULT_RATE_HZ, Detector
-from alfa_bench.methods.checks import parametrize_with_checks
+from alfa_bench.methods.contract import parametrize_with_checks
 
 REPO = Path(__file__).resolve().parent.parent
 
@@ -59,7 +59,7 @@ class Sideslip(Detector):
 
 
 def test_a_detector_without_init_has_no_parameters_and_meets_the_contract():
-    from alfa_bench.methods.checks import CHECKS
+    from alfa_bench.methods.contract import CHECKS
 
     d = Sideslip()
     assert d.get_params() == {} and d.channels() == ("sideslip",)
@@ -244,7 +244,7 @@ def test_errors_a_notebook_meets_say_what_to_do(local):
     with pytest.raises(ValueError, match=r"ThreeScores.update\(\) returned 3 value.*"
                                          r"1 channel\(s\) \['threescores'\]"):
         ab.evaluate(ThreeScores(), local, check=False)
-    from alfa_bench.methods.checks import ContractError
+    from alfa_bench.methods.contract import ContractError
 
     with pytest.raises(ContractError, match="check=False"):
         ab.evaluate(ThreeScores(), local)

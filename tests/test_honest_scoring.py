@@ -5,6 +5,7 @@ import math
 import pytest
 from scipy.stats import binomtest
 
+from alfa_bench.analysis.blocks import block
 from alfa_bench.analysis.scoring import (
     flight_outcome,
     mcnemar_exact,
@@ -13,7 +14,7 @@ from alfa_bench.analysis.scoring import (
     wilson_interval,
 )
 from alfa_bench.data import read_manifest
-from alfa_bench.outputs.tables import block, comparison_table
+from alfa_bench.outputs.tables import comparison_table
 
 
 def test_a_first_alarm_after_the_deadline_is_a_miss():

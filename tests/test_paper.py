@@ -125,8 +125,8 @@ def test_every_quoted_key_is_one_the_numbers_define():
     sweeps = pd.DataFrame([{"method": m, "subset": s, "fp": 0, "recall": 0.0}
                            for m in config["methods"] for s in config["subsets"]])
     # every catalogue signal and fault class, as the leakage audit writes them
+    from alfa_bench.analysis.blocks import FAULT_ORDER
     from alfa_bench.data import SIGNALS
-    from alfa_bench.outputs.tables import FAULT_ORDER
     leak = pd.DataFrame([{**leakage().iloc[0].to_dict(), "signal": sig, "fault_class": c}
                          for sig in SIGNALS for c in FAULT_ORDER if c != "none"])
     assert latex_keys(TEX) <= set(paper_numbers(pd.DataFrame(rows), sweeps, leak))

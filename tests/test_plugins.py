@@ -61,13 +61,13 @@ def test_the_installed_plugin_is_registered_and_passes_the_contract(installed):
 @pytest.mark.workflow
 def test_the_plugin_checks_itself_with_parametrize_with_checks(installed, tmp_path):
     """The example's own test file, run from a copy as its author would: every check of
-    alfa_bench.methods.checks on two of its configurations."""
+    alfa_bench.methods.contract on two of its configurations."""
     own = shutil.copy(EXAMPLE / "test_alfa_cusum.py", tmp_path)
     done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
                            str(own)], capture_output=True, text=True, env=installed,
                           cwd=tmp_path)
     assert done.returncode == 0, done.stdout + done.stderr
-    from alfa_bench.methods.checks import CHECKS
+    from alfa_bench.methods.contract import CHECKS
     assert f"{2 * len(CHECKS)} passed" in done.stdout, done.stdout
 
 

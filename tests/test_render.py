@@ -1,6 +1,6 @@
 """Tables rendered for people: the HTML page the report shows inline."""
 
-from alfa_bench.outputs.render import markdown, markdown_html
+from alfa_bench.render import markdown, markdown_html
 
 
 def test_markdown_html_keeps_titles_tables_lists_and_marks():

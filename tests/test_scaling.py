@@ -1,5 +1,5 @@
 """benchmarks/scaling.py lays measured job times out along the rule graph, and the
-resources each rule declares (scripts/helpers/resources.py) hold what its jobs use."""
+resources each rule declares (workflow/resources.py) hold what its jobs use."""
 
 import csv
 import importlib.util

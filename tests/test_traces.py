@@ -2,10 +2,10 @@
 
 import numpy as np
 
-from alfa_bench.analysis.traces import read_trace, read_traces, write_trace
 from alfa_bench.data import load_flight
 from alfa_bench.methods import make_detector, run_detector
 from alfa_bench.outputs.provenance import read_provenance
+from alfa_bench.outputs.traces import read_trace, read_traces, write_trace
 
 
 def test_round_trip_keeps_every_value_and_rebuilds_alarms(one_flight, tmp_path):

@@ -13,16 +13,11 @@ from broken import GT, IMU, ROLL, _gap, _late_start, edit, set_cell, shift_time
 from unavailable import unavailable
 from workflow_runs import GRID, REPO, SNAKEMAKE, assert_same_results, run_workflow
 
-from alfa_bench.analysis.detections import (
-    INJECTED_RECORDS,
-    RUN_RECORD,
-    iter_records,
-    read_run_record,
-)
-from alfa_bench.analysis.traces import read_trace
 from alfa_bench.data.synthetic import write_flight
 from alfa_bench.methods import REGISTRY, make_detector
 from alfa_bench.outputs.provenance import RUN_FILE, read_provenance, read_table
+from alfa_bench.outputs.records import INJECTED_RECORDS, RUN_RECORD, iter_records, read_run_record
+from alfa_bench.outputs.traces import read_trace
 
 # Snakemake or pip in a subprocess, minutes in all: `pytest -m "not workflow"` skips them
 pytestmark = pytest.mark.workflow

@@ -2,7 +2,7 @@
 
 from alfa_cusum import Cusum
 
-from alfa_bench.methods.checks import parametrize_with_checks
+from alfa_bench.methods.contract import parametrize_with_checks
 
 
 @parametrize_with_checks([Cusum(), Cusum(signal="pitch_error", false_alarm=0.2)])

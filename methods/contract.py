@@ -26,7 +26,7 @@ and raises ``AssertionError`` where the contract fails:
 
 A plugin's own tests run them all with one decorator::
 
-    from alfa_bench.methods.checks import parametrize_with_checks
+    from alfa_bench.methods.contract import parametrize_with_checks
 
     @parametrize_with_checks([Cusum()])
     def test_cusum(detector, check):

@@ -28,6 +28,8 @@ from pathlib import Path
 import pandas as pd
 from threadpoolctl import threadpool_limits
 
+from alfa_bench.analysis.detections import detect_all
+from alfa_bench.analysis.per_flight import per_flight_table
 from alfa_bench.config import load_config
 from alfa_bench.data import (
     FAILURE_COLUMNS,
@@ -49,10 +51,8 @@ from alfa_bench.methods import (
     make_detector,
     source_digest,
 )
+from alfa_bench.outputs.records import read_failures, read_records
 from alfa_bench.outputs.tables import comparison_table, failures_table
-
-from .detections import detect_all, read_failures, read_records
-from .per_flight import per_flight_table
 
 __all__ = ["SCORING_SETTINGS", "Corpus", "Result", "compare", "evaluate", "load_corpus",
            "user_cache"]
@@ -207,7 +207,7 @@ class Result:
     def recording(self, flight: str, path: str | os.PathLike) -> Path:
         """Write the rerun recording of ``flight`` with this method's scores and
         intermediates (open it with ``rerun <path>``); return its path."""
-        from alfa_bench.outputs.provenance import run_provenance
+        from alfa_bench.analysis.provenance import run_provenance
         from alfa_bench.outputs.rerun_log import (
             write_rerun_log,  # rerun: only where a recording is written
         )
@@ -251,7 +251,7 @@ def evaluate(detector: Detector | str, corpus: Corpus, *, name: str | None = Non
         Also score the config's injected sensor-fault grid (:attr:`Result.injected`).
     check : bool
         Run the quick contract checks on a detector instance first (shapes, thresholds,
-        causality on one synthetic flight: :func:`~alfa_bench.methods.checks.quick_check`,
+        causality on one synthetic flight: :func:`~alfa_bench.methods.contract.quick_check`,
         about a second); a config run's detector is checked by the test suite.
 
     ``detector`` is never fitted itself: each fold fits a clone (:attr:`Result.fitted`).
@@ -267,7 +267,7 @@ def evaluate(detector: Detector | str, corpus: Corpus, *, name: str | None = Non
         detector = make_detector(spec["detector"], spec.get("params"))
     else:
         if check:
-            from alfa_bench.methods.checks import quick_check  # the synthetic corpus
+            from alfa_bench.methods.contract import quick_check  # the synthetic corpus
 
             quick_check(detector)
         spec = {"detector": detector_name(detector), "params": detector.get_params()}
