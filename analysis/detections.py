@@ -319,6 +319,7 @@ def detection_record(method: str, spec: dict, detector: Detector, flight: Flight
         # a detector of a script or notebook: which code scored (methods.source_digest)
         **({"detector_source": spec["source"]} if "source" in spec else {}),
         "role": spec.get("role", "method"),
+        "family": detector.family,
         # whether it reads what the fault emulation writes: from its signals, never set
         "reads_actuators": reads_actuators(detector.signals()),
         "signal_kinds": {n: SIGNALS[n].kind for n in detector.signals()},

@@ -15,6 +15,7 @@ from importlib.metadata import entry_points
 
 from .base import (
     DEFAULT_RATE_HZ,
+    FAMILIES,
     CalibrationError,
     Detector,
     Fork,
@@ -35,7 +36,7 @@ from .base import (
 )
 from .extremes import MaximaThresholds
 
-__all__ = ["BUILTIN", "BUILTIN_ENTRIES", "DEFAULT_RATE_HZ", "PLUGIN_GROUP", "REGISTRY",
+__all__ = ["BUILTIN", "BUILTIN_ENTRIES", "DEFAULT_RATE_HZ", "FAMILIES", "PLUGIN_GROUP", "REGISTRY",
            "CalibrationError", "Detector", "Fork", "Labelled", "MaximaThresholds",
            "NotFittedError", "PairDetector", "StaleStateError", "Trace", "clone", "detector_name",
            "fault_free_segments", "fit_token", "forks", "labelled_segments", "make_detector",
@@ -58,6 +59,9 @@ BUILTIN_ENTRIES = {
     "coincidence": "coincidence:Coincidence",
     "emulation_oracle": "emulation_oracle:EmulationOracle",
     "end_of_flight": "end_of_flight:EndOfFlight",
+    "silent": "silent:Silent",
+    "pyod": "outliers:PyODDetector",
+    "river": "outliers:RiverDetector",
 }
 
 

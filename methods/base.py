@@ -64,7 +64,7 @@ import numpy as np
 
 from alfa_bench.data import Flight, Sampled, not_measured, sample
 
-__all__ = ["DEFAULT_RATE_HZ", "CalibrationError", "Detector", "Fork", "Labelled",
+__all__ = ["DEFAULT_RATE_HZ", "FAMILIES", "CalibrationError", "Detector", "Fork", "Labelled",
            "NotFittedError", "PairDetector", "StaleStateError", "Trace", "clone",
            "fault_free_segments", "fit_token", "forks", "json_ready", "labelled_segments",
            "learned_state", "run_detector", "skipped_channels", "source_digest",
@@ -72,6 +72,10 @@ __all__ = ["DEFAULT_RATE_HZ", "CalibrationError", "Detector", "Fork", "Labelled"
 
 log = logging.getLogger(__name__)
 
+
+#: the families of detectors the tables name, and ``other`` for one that says none
+FAMILIES = ("model residuals", "parameter monitoring", "statistical test", "generic outlier",
+            "supervised classifier", "reference", "other")
 
 #: the grid rate of a detector that does not set its own, Hz: ALFA's attitude rows come
 #: at about 20 Hz
@@ -125,12 +129,26 @@ def _feed(h, value, seen: set[int]) -> None:
         h.update(b"]")
     elif isinstance(value, set | frozenset):
         _feed(h, sorted(value, key=repr), seen)
-    elif hasattr(value, "__dict__") and id(value) not in seen:
+    elif isinstance(value, type) or callable(value) and hasattr(value, "__qualname__"):
+        h.update(f"{getattr(value, '__module__', '')}.{value.__qualname__}".encode())
+    elif id(value) in seen:
+        h.update(b"<seen>")
+    elif hasattr(value, "__dict__"):
         seen.add(id(value))
         h.update(f"{type(value).__module__}.{type(value).__qualname__}".encode())
         _feed(h, vars(value), seen)
     else:
-        h.update(repr(value).encode())
+        # an extension type (a scikit-learn tree): by what it pickles as
+        seen.add(id(value))
+        h.update(type(value).__qualname__.encode())
+        try:
+            reduced = value.__reduce_ex__(4)
+        except (TypeError, ValueError):
+            reduced = None
+        if isinstance(reduced, tuple):
+            _feed(h, list(reduced[1:3]), seen)
+        else:
+            h.update(repr(value).encode())
 
 
 def _digest(*values) -> str:
@@ -257,6 +275,9 @@ class Detector(ABC):
     #: whatever their values, the scores and all else it learns are the same, and
     #: :meth:`rethreshold` sets the thresholds for new values without fitting again
     threshold_params: tuple[str, ...] = ()
+    #: the family the tables group it in, one of :data:`FAMILIES` (a detector that says
+    #: none is ``other``)
+    family: str = "other"
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)

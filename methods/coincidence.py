@@ -81,6 +81,8 @@ class Coincidence(MaximaThresholds, Detector):
         and :math:`\\gamma_c` (:class:`~.extremes.MaximaThresholds`).
     """
 
+    family = "model residuals"
+
     rate_hz = RATE_HZ
 
     def __init__(self, signatures=DEFAULT_SIGNATURES, quantile=0.99, false_alarm=0.1):

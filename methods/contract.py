@@ -50,6 +50,7 @@ from alfa_bench.data import SIGNALS, load_flight, sample
 from alfa_bench.data.synthetic import write_corpus
 
 from .base import (
+    FAMILIES,
     CalibrationError,
     Detector,
     NotFittedError,
@@ -156,6 +157,10 @@ def check_outputs_have_the_declared_shape(detector: Detector) -> None:
     assert trace.score.shape == trace.alarm.shape == (trace.t.size, len(d.channels()))
     assert trace.alarm.dtype == bool
     assert np.all(np.diff(trace.t) > 0)
+
+
+def check_its_family_is_one_the_tables_name(detector: Detector) -> None:
+    assert detector.family in FAMILIES, detector.family
 
 
 def check_each_channel_names_the_measured_signal_it_scores(detector: Detector) -> None:
@@ -368,6 +373,7 @@ CHECKS = (
     check_fitted_values_are_json_ready,
     check_outputs_have_the_declared_shape,
     check_each_channel_names_the_measured_signal_it_scores,
+    check_its_family_is_one_the_tables_name,
     check_each_channel_has_one_positive_threshold,
     check_probes_are_named_once_and_do_not_change_the_run,
     check_batch_run_equals_streaming,

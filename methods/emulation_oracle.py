@@ -70,6 +70,8 @@ class EmulationOracle(Detector):
         Steps consumed since :meth:`reset`.
     """
 
+    family = "reference"
+
     calibrated = True
 
     def __init__(self, rate_hz=10.0):

@@ -33,6 +33,8 @@ class EndOfFlight(Detector):
         Steps consumed since :meth:`reset`.
     """
 
+    family = "reference"
+
     causal = False
 
     def __init__(self, rate_hz=25.0):

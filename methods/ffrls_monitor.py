@@ -188,6 +188,8 @@ class FfRlsMonitor(Detector):
         :meth:`run` (what :meth:`snapshot` copies).
     """
 
+    family = "parameter monitoring"
+
     calibrated = True
 
     def __init__(self, models=DEFAULT_MODELS, rate_hz=10.0, forgetting=0.98, p0=1e3,

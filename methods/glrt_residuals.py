@@ -82,6 +82,8 @@ class GlrtResiduals(PairDetector):
         The last residual (NaN while not armed) and output per pair.
     """
 
+    family = "statistical test"
+
     calibrated = True
 
     def __init__(self, pairs=DEFAULT_PAIRS, residuals="arx", threshold="empirical",

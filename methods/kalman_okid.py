@@ -79,6 +79,8 @@ class KalmanOkid(Detector):
         The last output and innovation per output (NaN while not armed).
     """
 
+    family = "model residuals"
+
     calibrated = True
 
     def __init__(self, inputs=("roll_cmd", "pitch_cmd"), outputs=("roll", "pitch"),

@@ -80,6 +80,8 @@ class LearnedFusion(MaximaThresholds, Detector):
         (:class:`~.extremes.MaximaThresholds`).
     """
 
+    family = "model residuals"
+
     def __init__(self, models=DEFAULT_MODELS, lags_s=(0.0, 0.5, 1.0, 2.0), window_s=1.0,
                  baseline_s=20.0, max_components=6, thin=5, false_alarm=0.1, random_state=0,
                  rate_hz=20.0):

@@ -162,6 +162,10 @@ class NestedSelection(Detector):
     def causal(self) -> bool:
         return self._reference().causal
 
+    @property
+    def family(self) -> str:
+        return self._reference().family
+
     def signals(self) -> tuple[str, ...]:
         return self._reference().signals()
 

@@ -154,6 +154,8 @@ class ResidualBank(MaximaThresholds, Detector):
         sums and counts of (2); the intermediates of the last step.
     """
 
+    family = "model residuals"
+
     def __init__(self, models=DEFAULT_MODELS, lags_s=(0.0, 0.5, 1.0, 2.0), window_s=1.0,
                  baseline_s=20.0, false_alarm=0.1, rate_hz=20.0):
         self.models = models

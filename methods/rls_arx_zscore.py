@@ -152,6 +152,8 @@ class RlsArxZscore(PairDetector):
         Per pair, the outputs of the last step (see :meth:`advance`).
     """
 
+    family = "model residuals"
+
     def __init__(self, pairs=DEFAULT_PAIRS, rate_hz=25.0, na=1, input_window_s=1.0,
                  p0=1e6, warmup_samples=200, eps=1e-3, stable_s=1.0, var_rtol=0.01,
                  var_stable_s=1.0, z_threshold=4.5, repeated_samples="hold"):

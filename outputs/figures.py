@@ -29,8 +29,9 @@ from alfa_bench.analysis.blocks import FAULT_ORDER  # noqa: E402
 from alfa_bench.analysis.detectability import EMPTY, by_fault, fault_name  # noqa: E402
 from alfa_bench.render import fmt  # noqa: E402
 
-__all__ = ["BLOCK_STYLES", "DPI", "colors", "deadline_figure", "detectability_figure",
-           "detection_time_figure", "save", "sweep_figure"]
+__all__ = ["BLOCK_STYLES", "DPI", "SWEEP_LEGEND", "colors", "deadline_figure",
+           "detectability_figure", "detection_time_figure", "save", "sweep_figure",
+           "sweep_legend"]
 
 #: the resolution of every figure, dots per inch
 DPI = 110
@@ -63,7 +64,8 @@ def sweep_figure(sweep: pd.DataFrame, subset: str, path: str | Path) -> None:
     before onset."""
     data = sweep[sweep["subset"] == subset]
     methods = list(dict.fromkeys(data["method"]))
-    palette = colors(methods)
+    shown = sweep_legend(data)
+    palette = colors(shown)
     deadline = float(data["deadline_s"].iloc[0]) if len(data) else float("nan")
     fig, axes = plt.subplots(1, 3, figsize=(15, 5.0), layout="constrained")
     panels = [
@@ -75,12 +77,20 @@ def sweep_figure(sweep: pd.DataFrame, subset: str, path: str | Path) -> None:
          "false alarms per hour of fault-free flight", "mean detection time (s)", "symlog"),
     ]
     for ax, (x, y, xlabel, ylabel, xscale) in zip(axes, panels, strict=True):
-        for m in methods:
+        # the runs outside the legend first, grey, under the best few
+        others = [m for m in methods if m not in shown]
+        for m in others + shown:
             d = data[data["method"] == m].sort_values("scale")
-            ax.plot(d[x], d[y], color=palette[m], label=f"{m} ({d['block'].iloc[0]})",
-                    alpha=0.9, **BLOCK_STYLES[d["block"].iloc[0]])
+            named = m in shown
+            color = palette[m] if named else "0.75"
+            label = (f"{m} ({d['block'].iloc[0]})" if named else
+                     f"{len(others)} other runs (grey)" if m == others[-1] else None)
+            ax.plot(d[x], d[y], color=color, label=label, alpha=0.9 if named else 0.6,
+                    **({**BLOCK_STYLES[d["block"].iloc[0]], "lw": 0.8} if not named
+                       else BLOCK_STYLES[d["block"].iloc[0]]))
             at = d[d["scale"] == 1.0]
-            ax.plot(at[x], at[y], "o", color=palette[m], ms=6, mec="black", mew=0.6)
+            ax.plot(at[x], at[y], "o", color=color, ms=6 if named else 4,
+                    mec="black" if named else "0.6", mew=0.6)
         ax.set_xscale(xscale, **({"linthresh": 1.0} if xscale == "symlog" else {}))
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
@@ -89,12 +99,26 @@ def sweep_figure(sweep: pd.DataFrame, subset: str, path: str | Path) -> None:
     axes[0].set_ylim(-0.02, 1.02)
     axes[1].set_ylim(-0.02, 1.02)
     handles, labels = axes[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside lower center", ncol=min(4, len(methods)),
-               fontsize=8)
+    fig.legend(handles, labels, loc="outside lower center", ncol=min(4, len(labels)),
+               fontsize=9)
     n = int(data["flights"].iloc[0]) if len(data) else 0
     fig.suptitle(f"Threshold sweep, subset '{subset}' ({n} flights): every channel "
                  "threshold scaled by one factor; dots = configured thresholds")
     save(fig, path)
+
+
+#: the runs the sweep's legend names: the best honest ones at the configured thresholds
+SWEEP_LEGEND = 6
+
+
+def sweep_legend(data: pd.DataFrame) -> list[str]:
+    """The :data:`SWEEP_LEGEND` honest runs of a subset's sweep with the most faults
+    detected in time at the configured thresholds (fewer fault-free flights alarmed
+    first among equals), best first: the curves drawn in colour."""
+    at = data[(data["scale"] == 1.0) & (data["block"] == "honest")]
+    best = at.sort_values(["recall", "false_alarm_flights"], ascending=[False, True],
+                          kind="stable")
+    return list(dict.fromkeys(best["method"]))[:SWEEP_LEGEND]
 
 
 def detection_time_figure(records: list[dict], flights: list[str], deadline_s: float,

@@ -18,7 +18,7 @@ import pandas as pd
 from alfa_bench.analysis.blocks import FAULT_ORDER
 from alfa_bench.render import fmt
 
-from .tables import SUBSET_NOTES
+from .tables import SILENT, SUBSET_NOTES
 
 __all__ = ["index_html"]
 
@@ -36,38 +36,58 @@ img { max-height: 330px; max-width: 100%; border: 1px solid #eee; }
 .links a { margin-right: 14px; } .note { color: #555; font-size: 12px; }
 """
 
-#: the runs the per-class table shows, best first (every run: comparison.md)
-CLASS_ROWS = 8
+#: the ranked runs the headline table shows, and those the per-class table shows, best
+#: first (every run: comparison.html)
+RANKED_ROWS = 10
+CLASS_ROWS = 6
 
 
 def _row(cells: list[str], tag: str = "td") -> str:
     return "<tr>" + "".join(f"<{tag}>{html.escape(c)}</{tag}>" for c in cells) + "</tr>"
 
 
-def index_html(comparison: pd.DataFrame, by_fault: pd.DataFrame, sweep_png: Path,
-               primary: str, run: str) -> str:
-    """The page (module docstring) from the run's ``comparison`` and ``by_fault``
-    tables and its sweep figure; ``run`` names the run in the footer."""
-    table = comparison[(comparison["subset"] == primary) & comparison["rank"].notna()]
-    table = table.sort_values("rank")
-    d = fmt(float(comparison["deadline_s"].iloc[0]), digits=1)
-    flights = int(table["flights"].iloc[0]) if len(table) else 0
-    head = ["rank", "method", f"faults detected ≤{d} s", "of them stable",
-            "over calibration pools", "fault-free flights alarmed", "precision %",
-            "recall %", "accuracy %", "mean det. s", "rank over pools"]
-    rows = [_row(head, "th")]
-    for r in table.to_dict(orient="records"):
-        stable = r.get("stable_detections")
-        pooled = fmt(stable) != "-"
-        rows.append(_row([
-            str(int(r["rank"])), r["method"], f"{int(r['tp'])} of {int(r['tp'] + r['fn'])}",
-            str(int(stable)) if pooled else "no pools",
+def _cells(r: dict) -> list[str]:
+    """A ranked run's row of the headline table."""
+    stable = r.get("stable_detections")
+    pooled = fmt(stable) != "-"
+    return [str(int(r["rank"])), r["method"], r["family"],
+            f"{int(r['tp'])} of {int(r['tp'] + r['fn'])}",
+            str(int(stable)) if pooled else "not resampled",
             (f"{fmt(r['detections_low'], digits=0)}-{fmt(r['detections_high'], digits=0)}"
              if pooled else "-"),
             f"{int(r['fault_free_false_alarms'])} of {int(r['fault_free_flights'])}",
             fmt(r["precision"], True, 1), fmt(r["recall"], True, 1),
             fmt(r["accuracy"], True, 1), fmt(r["mean_detection_s"]),
-            str(r.get("rank_range") or "-")]))
+            str(r.get("rank_range") or "-")]
+
+
+def index_html(comparison: pd.DataFrame, by_fault: pd.DataFrame, sweep_png: Path,
+               primary: str, run: str) -> str:
+    """The page (module docstring) from the run's ``comparison`` and ``by_fault``
+    tables and its sweep figure; ``run`` names the run in the footer."""
+    subset = comparison[comparison["subset"] == primary]
+    table = subset[subset["rank"].notna()].sort_values("rank")
+    d = fmt(float(comparison["deadline_s"].iloc[0]), digits=1)
+    flights = int(table["flights"].iloc[0]) if len(table) else 0
+    head = ["rank", "method", "family", f"faults detected ≤{d} s", "of them stable",
+            "range, calibration resampled", "fault-free flights alarmed", "precision %",
+            "recall %", "accuracy %", "mean det. s", "rank range, resampled"]
+    rows = [_row(head, "th")] + [_row(_cells(r)) for r in
+                                 table.head(RANKED_ROWS).to_dict(orient="records")]
+    more = len(table) - RANKED_ROWS
+    shown = f" (the best {RANKED_ROWS}; {more} more in every run and subset)" if more > 0 else ""
+    silent = subset[subset["detector"] == SILENT]
+    quiet = (f" A run that arms and never alarms (<code>{SILENT}</code>) scores "
+             f"{fmt(silent['accuracy'].iloc[0], True, 1)} % accuracy: "
+             f"{int((~table['beats_silence'].astype(bool)).sum())} of {len(table)} ranked "
+             "runs do no better, and are flagged in the tables." if len(silent) else "")
+    best = table.drop_duplicates("family")
+    family_rows = [_row(["family", "best run", "rank", f"detected ≤{d} s",
+                         "fault-free alarmed"], "th")] + [
+        _row([r["family"], r["method"], str(int(r["rank"])),
+              f"{int(r['tp'])} of {int(r['tp'] + r['fn'])}",
+              f"{int(r['fault_free_false_alarms'])} of {int(r['fault_free_flights'])}"])
+        for r in best.to_dict(orient="records")]
     classes = [c for c in FAULT_ORDER if c != "none"]
     per_class = by_fault[(by_fault["subset"] == primary)
                          & by_fault["method"].isin(table["method"])]
@@ -86,16 +106,21 @@ def index_html(comparison: pd.DataFrame, by_fault: pd.DataFrame, sweep_png: Path
 <h1>alfa-bench: online fault detectors on the ALFA flights</h1>
 <p>Headline: subset <code>{html.escape(primary)}</code> ({flights} flights{note}).
 A fault counts as detected when the first alarm comes at most {d} s after its onset.
-Only honest runs (sensors and setpoints only) are ranked. A detection is <em>stable</em>
-when it survives at least the configured share of resampled calibration pools.</p>
+Only honest runs (sensors and setpoints only) are ranked: by accuracy within the deadline
+(faults detected in time and fault-free flights left quiet, of all flights), then
+recall, then mean detection time.{quiet} A detection is <em>stable</em> when it
+survives when the calibration flights are resampled (most of the resamples; "not
+resampled": thresholds that need a refit).</p>
 <p class="links"><a href="tables/comparison.html">every run and subset</a>
 <a href="tables/stability.md">stability</a> <a href="tables/per_flight.md">per flight</a>
 <a href="../paper/build/paper.md">the paper</a> <a href="report.html">the Snakemake report</a></p>
-<h2>Ranked honest runs, deadline {d} s</h2>
+<h2>Ranked honest runs, deadline {d} s{shown}</h2>
 <table>{''.join(rows)}</table>
 <div class="row"><div>
 <h2>Faults detected in time, by class (the best {CLASS_ROWS})</h2>
-<table>{''.join(class_rows)}</table></div>
+<table>{''.join(class_rows)}</table>
+<h2>The best run of each family</h2>
+<table>{''.join(family_rows)}</table></div>
 <div><h2>Threshold sweep</h2>
 <a href="figures/sweep.png"><img alt="Threshold sweep of every method"
      src="data:image/png;base64,{figure}"></a>

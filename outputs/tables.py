@@ -39,11 +39,14 @@ from alfa_bench.analysis.stability import pool_summaries, stability_table
 from alfa_bench.data import FAILURE_COLUMNS, subset_flights
 from alfa_bench.render import Section, fmt, latex_tables, markdown
 
-__all__ = ["SIGNIFICANCE", "by_fault_latex",
+__all__ = ["SIGNIFICANCE", "SILENT", "by_fault_latex",
            "by_fault_markdown", "by_fault_table", "comparison_latex", "comparison_markdown",
            "comparison_notes", "comparison_table", "configurations", "failures_table",
            "refit_markdown", "stability_markdown", "summary_latex", "summary_markdown",
            "summary_table", "unscored_notes"]
+
+#: the reference run that arms and never alarms (methods/silent.py): the line to beat
+SILENT = "silent"
 
 #: the level below which the exact McNemar test tells two runs apart
 SIGNIFICANCE = 0.05
@@ -168,6 +171,7 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
                        for r, o in zip(recs, outcomes, strict=True)}
             runs.append((correct, {
                 "subset": subset, "method": method, "block": block(recs[0]),
+                "family": recs[0].get("family", "other"),
                 "detector": recs[0]["detector"], "calibration": _calibration(recs[0]),
                 "configurations": max(configurations(r) for r in recs),
                 "deadline_s": deadline_s, **s,
@@ -197,8 +201,12 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
         ordered = ranked + [r for r in honest if r[1]["not_ranked"]] + [
             r for b in BLOCKS[1:] for r in runs if r[1]["block"] == b]
         best_correct, best = ranked[0] if ranked else ({}, None)
+        silence = [row for _, row in runs if row["detector"] == SILENT]
         for correct, row in ordered:
             row["best_honest"] = best["method"] if best else ""
+            # no better than a run that never alarms: its accuracy is not above silence's
+            row["beats_silence"] = (_num(row["accuracy"]) > _num(silence[0]["accuracy"])
+                                    if silence and row["detector"] != SILENT else None)
             both = [f for f in correct if f in best_correct]
             test = (mcnemar_exact([correct[f] for f in both], [best_correct[f] for f in both])
                     if best and row is not best else
@@ -403,8 +411,9 @@ def _comparison_sections(comparison: pd.DataFrame, primary: str | None = None
             why = r.get("not_ranked")
             return [why if isinstance(why, str) and why else
                     "-" if fmt(rank) == "-" else str(int(rank)),
-                    r["method"], r["detector"],
-                    r["calibration"],
+                    r["method"] + (" (no better than silence)"
+                                   if r.get("beats_silence") is False else ""),
+                    r["detector"], r["calibration"],
                     _rate(r, "precision"), _rate(r, "recall"), _rate(r, "accuracy"),
                     _stable(r), r["rank_range"] if isinstance(r.get("rank_range"), str) else "-",
                     fmt(r.get("mean_detection_s")), fmt(r.get("max_detection_s")),

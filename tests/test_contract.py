@@ -15,8 +15,13 @@ from alfa_bench.methods.contract import parametrize_with_checks
 CONFIG = yaml.safe_load((Path(__file__).parent.parent / "config/config.yaml").read_text())
 RUNS = {name: (spec["detector"], spec.get("params", {})) for name, spec in
         CONFIG["methods"].items()}
-CASES = {**{f"registry:{n}": make_detector(n) for n in REGISTRY},
-         **{f"config:{n}": make_detector(*r) for n, r in RUNS.items()}}
+CASES = {f"registry:{n}": make_detector(n) for n in REGISTRY}
+# a configured run that is a registered detector with its defaults is checked once
+for _name, _run in RUNS.items():
+    _made = make_detector(*_run)
+    if not any(type(d) is type(_made) and d.get_params() == _made.get_params()
+               for d in CASES.values()):
+        CASES[f"config:{_name}"] = _made
 
 
 @parametrize_with_checks(CASES)

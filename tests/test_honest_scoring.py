@@ -152,3 +152,24 @@ def test_ranks_compare_runs_on_the_same_flights_and_never_a_silent_one(corpus_ma
     assert table.loc["partial", "not_ranked"] == f"scored on {len(flights) - 1} of {len(flights)}"
     assert table.loc["silent", "not_ranked"] == "never armed"
     assert list(table.index) == ["fair", "partial", "silent"]
+
+
+def test_a_run_no_better_than_silence_is_flagged(corpus_manifest):
+    """Beside a run that arms and never alarms, a run whose accuracy under the deadline
+    is not above it is flagged, in the table and its Markdown; one above it is not."""
+    from alfa_bench.outputs.tables import comparison_markdown
+
+    flights = corpus_manifest.loc[corpus_manifest["ground_truth"]]
+    records = []
+    for r in flights.itertuples():
+        onset = None if math.isnan(r.onset_s) else r.onset_s
+        records += [{**_record("silent", r.flight, onset, None, role="reference"),
+                     "detector": "silent"},
+                    _record("quiet", r.flight, onset, None),
+                    _record("timely", r.flight, onset, None if onset is None else onset + 1)]
+    table = comparison_table(records, corpus_manifest, ["all"], 5.0).set_index("method")
+    assert table.loc["timely", "beats_silence"] and not table.loc["quiet", "beats_silence"]
+    assert table.loc["quiet", "accuracy"] == table.loc["silent", "accuracy"]
+    assert table.loc["silent", "beats_silence"] is None
+    text = comparison_markdown(table.reset_index())
+    assert "quiet (no better than silence)" in text and "timely (no" not in text

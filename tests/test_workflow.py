@@ -186,8 +186,8 @@ def test_the_results_page_opens_on_the_headline(runs):
     comparison = read_table(runs[0] / "results/tables/comparison.csv")
     best = comparison[(comparison["subset"] == "no_emr") & (comparison["rank"] == 1)].iloc[0]
     headline, by_class = view.first_rows[:2]
-    assert headline.split("\t")[:3] == [
-        "1", best["method"], f"{best['tp']} of {best['tp'] + best['fn']}"], view
+    assert headline.split("\t")[:4] == [
+        "1", best["method"], best["family"], f"{best['tp']} of {best['tp'] + best['fn']}"], view
     assert by_class.split("\t")[:2] == ["1", best["method"]], view
     assert view.images and min(view.images) > 100 and not view.errors, view
     assert view.images_in_view == len(view.images) and view.page_width <= 1400, view

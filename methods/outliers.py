@@ -1,0 +1,376 @@
+r"""Generic outlier detectors (PyOD, river) as runs: what a researcher tries first.
+
+A model of `PyOD <https://pyod.readthedocs.io>`_ (``IForest``, ``ECOD``, ``COPOD``,
+``HBOS``, ``PCA``, ``KNN``, ``LOF``, ...) or of river's ``anomaly`` module
+(``HalfSpaceTrees``, ``LODA``, ...) scores each grid step from the features of a
+causal window of honest signals. Over the last :math:`W` steps
+(``window_s``) of each signal :math:`x` it sees
+
+.. math::
+
+    f(t) = \big(x(t),\ \bar x_W(t),\ s_W(t),\ x(t) - x(t - W + 1)\big)
+
+(the value, the window's mean, its standard deviation and its change), scaled by the
+fault-free training data: standardised for a PyOD model, as PyOD's ``standardizer``
+does, and min-max scaled for a river model, as river's ``MinMaxScaler`` does before a
+half-space tree. The model is the library's, with its defaults (a seed is set where
+it takes one and none was given, so that a run repeats); it is fitted on the
+fault-free segments of the other dates, a river model learning them row by row and
+then frozen. Its outlier score (PyOD's ``decision_function``, river's ``score_one``)
+is the channel's score.
+
+Thresholds come from per-flight maxima (:class:`~.extremes.MaximaThresholds`), taken
+out of sample: the calibration flights are split in two alternate halves, each
+half's maxima scored by the model fitted on the other (a model scores its own
+training rows low: a nearest-neighbour distance is then zero), and the model that
+scores is fitted on all of them. A flight is scored in one batch call of the model
+(:meth:`OutlierModel.run`): a PyOD model costs milliseconds a call and microseconds a
+row.
+"""
+
+from __future__ import annotations
+
+import copy
+import importlib
+import inspect
+import math
+from collections import deque
+
+import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
+
+from alfa_bench.data import Sampled
+
+from .base import CalibrationError, Detector, StaleStateError, fit_token
+from .extremes import MaximaThresholds
+from .windows import window_steps
+
+__all__ = ["DEFAULT_SIGNALS", "FEATURES", "TRANSDUCTIVE", "OutlierModel", "PyODDetector",
+           "RiverDetector", "alone_ecdf_scores", "window_features"]
+
+#: the honest signals a generic model reads by default: attitude against its command,
+#: body rates and specific force from the IMU, climb rate and the altitude error
+DEFAULT_SIGNALS = ("roll_error", "pitch_error", "roll_rate", "pitch_rate", "yaw_rate",
+                   "accel_x", "accel_y", "vel_up", "altitude_error")
+
+#: the features of each signal over its window, in order
+FEATURES = ("value", "mean", "std", "change")
+
+
+def window_features(window: np.ndarray) -> np.ndarray:
+    """The features :data:`FEATURES` of windows of shape (..., m, W), oldest first:
+    shape (..., 4 m), signal by signal."""
+    f = np.stack([window[..., -1], window.mean(axis=-1), window.std(axis=-1),
+                  window[..., -1] - window[..., 0]], axis=-1)
+    return f.reshape(*f.shape[:-2], -1)
+
+
+class OutlierModel(MaximaThresholds, Detector):
+    """A library's outlier model on causal window features (module docstring); the
+    library's adapter (:class:`PyODDetector`, :class:`RiverDetector`) says how it is
+    built, fitted and asked for scores.
+
+    Parameters
+    ----------
+    model : str or estimator, optional
+        The model's class name in the library (``"IForest"``, ``"HalfSpaceTrees"``), or
+        an unfitted instance (it is copied, never fitted itself); none: the library's
+        :attr:`default_model`.
+    params : dict, optional
+        The class's parameters by name; none: the library's defaults.
+    inputs : tuple of str
+        Honest signals to read (:data:`DEFAULT_SIGNALS`); ``signals()`` returns them.
+    window_s : float
+        :math:`W`, s.
+    false_alarm : float
+        Per-flight false-alarm level of the threshold.
+    rate_hz : float
+        Grid rate, Hz.
+    max_rows : int
+        At most this many training rows fit the model (evenly spaced): the cost of a
+        neighbour model grows with them.
+
+    Attributes
+    ----------
+    estimator_ : object
+        The fitted model.
+    center_, scale_ : ndarray
+        The features' scaling, from the training rows.
+    rows_ : int
+        Training rows the model was fitted on.
+    """
+
+    #: the library's name, for the records
+    library: str = ""
+    #: the model a run without ``model`` uses
+    default_model: str = ""
+    family = "generic outlier"
+
+    def __init__(self, model=None, params=None, inputs=DEFAULT_SIGNALS, window_s=2.0,
+                 false_alarm=0.1, rate_hz=2.5, max_rows=5000):
+        self.model = model
+        self.params = params
+        self.inputs = inputs
+        self.window_s = window_s
+        self.false_alarm = false_alarm
+        self.rate_hz = rate_hz
+        self.max_rows = max_rows
+
+    # -- what the library adapters say ---------------------------------------------------
+
+    def _build(self) -> object:
+        """A new, unfitted estimator: a copy of ``model``, or the library's class of that
+        name with ``params``; a seed set where it takes one and none was given."""
+        if not isinstance(self.model, str | None):
+            return copy.deepcopy(self.model)
+        cls = self._resolve(self._name())
+        params = dict(self.params or {})
+        seed = self._seed_name(cls)
+        if seed is not None and params.get(seed) is None:
+            params[seed] = 0
+        return cls(**params)
+
+    @staticmethod
+    def _seed_name(cls) -> str | None:
+        names = inspect.signature(cls).parameters
+        return next((n for n in ("random_state", "seed") if n in names), None)
+
+    def _resolve(self, name: str):
+        raise NotImplementedError
+
+    def _fit_estimator(self, estimator, X: np.ndarray):
+        raise NotImplementedError
+
+    def _score(self, estimator, X: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+    def _scaling(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        raise NotImplementedError
+
+    # -- the contract --------------------------------------------------------------------
+
+    def signals(self) -> tuple[str, ...]:
+        return tuple(self.inputs)
+
+    def _name(self) -> str:
+        """The model's class name."""
+        if self.model is None:
+            return self.default_model
+        return self.model if isinstance(self.model, str) else type(self.model).__name__
+
+    def channels(self) -> tuple[str, ...]:
+        return (f"{self.library}_{self._name()}".lower(),)
+
+    def _width(self) -> int:
+        return window_steps(self.window_s, self.rate_hz)
+
+    def _features(self, s: Sampled) -> np.ndarray:
+        """Per grid step of ``s``, its window's features, NaN until the window is full."""
+        w = self._width()
+        out = np.full((s.t.size, len(self.inputs) * len(FEATURES)), np.nan)
+        if s.t.size >= w:
+            out[w - 1:] = window_features(sliding_window_view(s.x, w, axis=0))
+        return out
+
+    def fit_model(self, segments: list[Sampled]) -> OutlierModel:
+        """Scale the training rows' features and fit the model on them (at most
+        ``max_rows``, evenly spaced)."""
+        X = np.vstack([f[~np.isnan(f).any(axis=1)] for f in map(self._features, segments)])
+        if len(X) < 2:
+            raise CalibrationError(f"{self.channels()[0]}: {len(X)} training rows of full "
+                                   f"{self.window_s} s windows")
+        if len(X) > self.max_rows:
+            X = X[np.linspace(0, len(X) - 1, self.max_rows).round().astype(int)]
+        self.center_, self.scale_ = self._scaling(X)
+        self.estimator_ = self._fit_estimator(self._build(), (X - self.center_) / self.scale_)
+        self.rows_ = len(X)
+        return self
+
+    def fit(self, segments: list[Sampled]) -> OutlierModel:
+        """Per-flight maxima out of sample (module docstring), then the model fitted on
+        every segment and the thresholds."""
+        if len(segments) < 2:
+            raise CalibrationError(f"{self.channels()[0]}: {len(segments)} calibration "
+                                   "segments; the out-of-sample maxima need two or more")
+        maxima, flights = [], []
+        for train, held in ((segments[0::2], segments[1::2]), (segments[1::2], segments[0::2])):
+            self.fit_model(train)
+            for s in held:
+                score, _ = self.run(s)
+                if np.isfinite(score).any():
+                    maxima.append(float(np.nanmax(score)))
+                    flights.append(s.flight)
+        self.fit_model(segments)
+        self.model_ = ()
+        self.maxima_, self.maxima_flights_ = {self.channels()[0]: maxima}, {
+            self.channels()[0]: flights}
+        return self.rethreshold()
+
+    def fitted(self) -> dict:
+        """The maxima and thresholds, and the model: its library, name, parameters,
+        training rows and feature scaling."""
+        out = super().fitted()
+        out["model"] = {"library": self.library, "name": self.channels()[0],
+                        "params": {k: repr(v) if not isinstance(v, int | float | str | bool)
+                                   and v is not None else v
+                                   for k, v in _params(self.estimator_).items()},
+                        "rows": self.rows_, "center": self.center_.tolist(),
+                        "scale": self.scale_.tolist()}
+        return out
+
+    def run(self, s: Sampled, probes: bool = False, start: int = 0,
+            state: object | None = None) -> tuple[np.ndarray, dict]:
+        """The scores of steps ``start:`` in one call of the model. A step's score reads
+        the window before it and the frozen model only, so a run continued from a
+        :meth:`snapshot` after ``start`` steps scores just the steps after them."""
+        self._check_fitted("estimator_")
+        if state is not None and state != self.snapshot():
+            raise StaleStateError(f"{type(self).__name__}: the state to continue from was "
+                                  "taken under another fit or other parameters")
+        first = max(start - self._width() + 1, 0)
+        f = self._features(s.since(first))[start - first:]
+        score = np.full(s.t.size - start, np.nan)
+        ok = ~np.isnan(f).any(axis=1)
+        if ok.any():
+            score[ok] = self._score(self.estimator_, (f[ok] - self.center_) / self.scale_)
+        return score[:, None], ({f"{self.channels()[0]}/score": score} if probes else {})
+
+    def snapshot(self) -> str:
+        """What a run continues from: the fit alone (the model is frozen, and a step's
+        features are read again from the window before it)."""
+        return fit_token(self)
+
+    def reset(self) -> OutlierModel:
+        self._check_fitted("estimator_")
+        self.window_ = deque(maxlen=self._width())
+        self.last_ = math.nan
+        return self
+
+    def update(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:
+        self.window_.append(np.asarray(x, dtype=float))
+        self.last_ = math.nan
+        if len(self.window_) == self.window_.maxlen:
+            f = window_features(np.array(self.window_).T)
+            self.last_ = float(self._score(self.estimator_,
+                                           ((f - self.center_) / self.scale_)[None, :])[0])
+        return np.array([self.last_])
+
+    def probes(self) -> dict[str, float]:
+        return {f"{self.channels()[0]}/score": getattr(self, "last_", math.nan)}
+
+
+def _params(estimator) -> dict:
+    get = getattr(estimator, "get_params", None)
+    if get is None:
+        return {}
+    try:
+        return get(deep=False)
+    except TypeError:
+        return get()
+
+
+class PyODDetector(OutlierModel):
+    r"""A PyOD model (``pyod.models``), fitted on the standardised features in one call
+    and scored by ``decision_function`` in one call per flight.
+
+    ECOD and COPOD score a batch *transductively*: ``decision_function(X)`` takes its
+    empirical CDFs and skewness over the training rows and every row of ``X`` together,
+    so a row's score would move with the rows after it (the contract's causality check
+    finds it). Here each row is scored as ``decision_function`` scores it alone, all
+    rows in one vectorised pass (:func:`alone_ecdf_scores`; a test checks it against
+    PyOD row by row)."""
+
+    library = "pyod"
+    default_model = "IForest"
+
+    def _resolve(self, name: str):
+        import pyod.models  # noqa: F401  (the models are modules of their own)
+
+        module = importlib.import_module(f"pyod.models.{_PYOD_MODULES.get(name, name.lower())}")
+        return getattr(module, name)
+
+    def _scaling(self, X):
+        std = X.std(axis=0)
+        return X.mean(axis=0), np.where(std > 0, std, 1.0)
+
+    def _fit_estimator(self, estimator, X):
+        estimator.fit(X)
+        if type(estimator).__name__ in TRANSDUCTIVE:
+            self.train_sorted_ = np.sort(X, axis=0)
+            self.train_sums_ = np.stack([X.sum(axis=0), (X ** 2).sum(axis=0),
+                                         (X ** 3).sum(axis=0)])
+        return estimator
+
+    def _score(self, estimator, X):
+        kind = type(estimator).__name__
+        if kind in TRANSDUCTIVE:
+            return alone_ecdf_scores(self.train_sorted_, self.train_sums_, X, kind)
+        return np.asarray(estimator.decision_function(X), dtype=float)
+
+
+#: PyOD models whose decision_function scores a batch transductively
+TRANSDUCTIVE = ("ECOD", "COPOD")
+
+
+def alone_ecdf_scores(train_sorted: np.ndarray, sums: np.ndarray, X: np.ndarray,
+                      kind: str) -> np.ndarray:
+    r"""ECOD's or COPOD's ``decision_function`` of each row of ``X`` on its own: over
+    the :math:`n` training rows (``train_sorted``, each column sorted) and the row
+    :math:`x`, the tail probabilities of feature :math:`j`
+
+    .. math::
+
+        U_l = -\ln \frac{\#\{x_{ij} \le x_j\} + 1}{n + 1}, \qquad
+        U_r = -\ln \frac{\#\{x_{ij} \ge x_j\} + 1}{n + 1},
+
+    the sign of the skewness of the :math:`n + 1` values (from the training sums
+    ``sums`` of :math:`x, x^2, x^3`) choosing the tail, :math:`U_s`; the score is
+    :math:`\sum_j \max(U_l, U_r, U_s)` (ECOD) or
+    :math:`\sum_j \max(U_s, (U_l + U_r)/2)` (COPOD)."""
+    n = train_sorted.shape[0]
+    le = np.stack([np.searchsorted(train_sorted[:, j], X[:, j], side="right")
+                   for j in range(X.shape[1])], axis=1)
+    ge = n - np.stack([np.searchsorted(train_sorted[:, j], X[:, j], side="left")
+                       for j in range(X.shape[1])], axis=1)
+    u_l = -np.log((le + 1) / (n + 1))
+    u_r = -np.log((ge + 1) / (n + 1))
+    m = n + 1
+    mean = (sums[0] + X) / m
+    m2 = (sums[1] + X ** 2) / m - mean ** 2
+    m3 = (sums[2] + X ** 3) / m - 3 * mean * (sums[1] + X ** 2) / m + 2 * mean ** 3
+    sign = np.where(m2 > 0, np.sign(m3), 0.0)
+    u_s = u_l * -np.sign(sign - 1) + u_r * np.sign(sign + 1)
+    if kind == "ECOD":
+        return np.maximum(u_s, np.maximum(u_l, u_r)).sum(axis=1)
+    return np.maximum(u_s, (u_l + u_r) / 2).sum(axis=1)
+
+
+#: PyOD's module of each model whose module is not its name in lower case
+_PYOD_MODULES = {"IForest": "iforest", "KNN": "knn", "LOF": "lof", "PCA": "pca",
+                 "HBOS": "hbos", "ECOD": "ecod", "COPOD": "copod", "OCSVM": "ocsvm"}
+
+
+class RiverDetector(OutlierModel):
+    """A river anomaly model (``river.anomaly``): it learns the min-max scaled training
+    rows one by one (``learn_one``), then is frozen and scores each step
+    (``score_one``)."""
+
+    library = "river"
+    default_model = "HalfSpaceTrees"
+
+    def _resolve(self, name: str):
+        from river import anomaly
+
+        return getattr(anomaly, name)
+
+    def _scaling(self, X):
+        low, high = X.min(axis=0), X.max(axis=0)
+        return low, np.where(high > low, high - low, 1.0)
+
+    def _fit_estimator(self, estimator, X):
+        for row in X:
+            estimator.learn_one(dict(enumerate(row.tolist())))
+        return estimator
+
+    def _score(self, estimator, X):
+        return np.array([estimator.score_one(dict(enumerate(row.tolist()))) for row in X])

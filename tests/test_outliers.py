@@ -1,0 +1,61 @@
+"""Generic outlier models as runs (methods/outliers.py): ECOD and COPOD scored row by
+row as PyOD scores a row alone, a seed where the library takes one, thresholds from
+out-of-sample maxima, and one line from a notebook."""
+
+import numpy as np
+import pytest
+
+import alfa_bench as ab
+from alfa_bench.methods import make_detector, training_segments
+from alfa_bench.methods.outliers import PyODDetector, RiverDetector, alone_ecdf_scores
+
+
+@pytest.mark.parametrize("kind", ["ECOD", "COPOD"])
+def test_a_row_is_scored_as_pyod_scores_it_alone(kind):
+    from pyod.models.copod import COPOD
+    from pyod.models.ecod import ECOD
+
+    rng = np.random.default_rng(1)
+    X = rng.standard_normal((400, 5))
+    X[:, 1] = rng.exponential(size=400)
+    X[:, 2] = np.round(X[:, 2], 1)                 # ties
+    rows = 2.0 * rng.standard_normal((30, 5))
+    rows[:4, 2] = X[:4, 2]
+    model = {"ECOD": ECOD, "COPOD": COPOD}[kind]().fit(X)
+    alone = [model.decision_function(r[None, :])[0] for r in rows]
+    sums = np.stack([X.sum(axis=0), (X ** 2).sum(axis=0), (X ** 3).sum(axis=0)])
+    np.testing.assert_allclose(alone_ecdf_scores(np.sort(X, axis=0), sums, rows, kind), alone,
+                               rtol=1e-12, atol=1e-12)
+    # in a batch, PyOD's scores move with the other rows: the reason for the above
+    assert not np.allclose(model.decision_function(rows), alone)
+
+
+def test_a_seed_is_set_only_where_none_was_given():
+    assert PyODDetector("IForest")._build().random_state == 0
+    assert PyODDetector("IForest", params={"random_state": 7})._build().random_state == 7
+    assert RiverDetector()._build().seed == 0
+    assert not hasattr(PyODDetector("HBOS")._build(), "random_state")
+
+
+def test_maxima_are_out_of_sample_and_cover_every_segment(corpus_flights):
+    d = make_detector("pyod", {"model": "KNN"})
+    flights = [f for f in corpus_flights.values() if f.fault is not None]
+    segments = training_segments(d, flights, margin_s=1.0)
+    d.fit(segments)
+    channel = d.channels()[0]
+    assert sorted(d.maxima_flights_[channel]) == sorted(s.flight for s in segments)
+    # in sample, a neighbour model scores its own rows lower: its maxima would be lower
+    in_sample = [np.nanmax(d.run(s)[0]) for s in segments]
+    assert np.mean(in_sample) < np.mean(d.maxima_[channel])
+    assert d.fitted()["model"]["library"] == "pyod" and d.fitted()["model"]["rows"] > 0
+
+
+def test_any_model_is_one_line_from_a_notebook(corpus, tmp_path):
+    from pyod.models.hbos import HBOS
+
+    corpus_ = ab.load_corpus(corpus.parent, cache=tmp_path / "cache")
+    mine = HBOS(n_bins=8)
+    result = ab.evaluate(PyODDetector(mine, inputs=("roll_error", "pitch_error"),
+                                      window_s=1.0), corpus_)
+    assert result.records and not hasattr(mine, "decision_scores_")   # a copy was fitted
+    assert {r["family"] for r in result.records} == {"generic outlier"}
