@@ -83,8 +83,7 @@ def sweep_figure(sweep: pd.DataFrame, subset: str, path: str | Path) -> None:
             d = data[data["method"] == m].sort_values("scale")
             named = m in shown
             color = palette[m] if named else "0.75"
-            label = (f"{m} ({d['block'].iloc[0]})" if named else
-                     f"{len(others)} other runs (grey)" if m == others[-1] else None)
+            label = f"{m} ({d['block'].iloc[0]})" if named else None
             ax.plot(d[x], d[y], color=color, label=label, alpha=0.9 if named else 0.6,
                     **({**BLOCK_STYLES[d["block"].iloc[0]], "lw": 0.8} if not named
                        else BLOCK_STYLES[d["block"].iloc[0]]))
@@ -98,6 +97,9 @@ def sweep_figure(sweep: pd.DataFrame, subset: str, path: str | Path) -> None:
     axes[0].set_xlim(-0.02, 1.02)
     axes[0].set_ylim(-0.02, 1.02)
     axes[1].set_ylim(-0.02, 1.02)
+    if len(methods) > len(shown):
+        axes[0].plot([], [], color="0.75", lw=0.8,
+                     label=f"{len(methods) - len(shown)} other runs (grey)")
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="outside lower center", ncol=min(4, len(labels)),
                fontsize=9)
