@@ -141,7 +141,7 @@ def per_flight_markdown(table: pd.DataFrame, deadline_s: float) -> str:
         sections.append((f"`{method}`{mark}, deadline {deadline_s:g} s",
                          ["flight", "fault", "emr", "outcome", "what happened",
                           f"largest score/threshold, onset to +{deadline_s:g} s",
-                          "largest before onset", "survival over calibration pools"],
+                          "largest before onset", "survival, calibration flights resampled"],
                          [[f"`{r['flight']}`", r["fault_class"],
                            "yes" if r["emergency_trajectory"] else "",
                            fmt(r["outcome"]), r["verdict"],

@@ -378,11 +378,12 @@ SUBSET_NOTES = {
 
 def _stable(r) -> str:
     """In-time detections, stable ones and their interval over the calibration pools:
-    ``7: 3 stable [4, 8]``; the count alone where the run has no pools."""
+    ``7: 3 stable [4, 8]``; the count alone where its thresholds cannot be set again
+    for resampled calibration flights without a refit."""
     if fmt(r.get("tp")) == "-":
         return "-"
     if fmt(r.get("stable_detections")) == "-":
-        return f"{int(r['tp'])} (no pools)"
+        return f"{int(r['tp'])} (not resampled)"
     return (f"{int(r['tp'])}: {int(r['stable_detections'])} stable "
             f"[{fmt(r['detections_low'], digits=0)}, {fmt(r['detections_high'], digits=0)}]")
 
@@ -394,8 +395,9 @@ def _comparison_sections(comparison: pd.DataFrame, primary: str | None = None
         d = _deadline(table)
         header = ["rank", "method", "detector", "calibration", f"precision % ≤{d} s [95 % CI]",
                   f"recall % ≤{d} s [95 % CI]", f"accuracy % ≤{d} s [95 % CI]",
-                  f"detections ≤{d} s: stable [interval over calibration pools]",
-                  "rank over calibration pools",
+                  f"detections ≤{d} s: stable [range when the calibration flights are "
+                  "resampled]",
+                  "rank range, calibration flights resampled",
                   "mean det. s", "max det. s", "accuracy % (paper's rule)",
                   "mean det. s (paper's rule)", "false alarms, fault-free flights",
                   "in-time detections first on the fault's axis %",

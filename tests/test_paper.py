@@ -136,7 +136,8 @@ def test_latex_tables_escape_and_label():
     tex = comparison_latex(comparison())
     assert r"\label{tab:comparison-1}" in tex and r"\texttt{all}" in tex
     assert "\\toprule" in tex and tex.count(r"\begin{table}") == 1
-    assert (" & 50.0 & 25.0 & 40.0 & 2 (no pools) & - & 1.50 & - & 70.00 & 6.00 & 1 of 3 & - & "
+    assert (" & 50.0 & 25.0 & 40.0 & 2 (not resampled) & - & 1.50 & - & 70.00 & 6.00 & "
+            "1 of 3 & - & "
             "0 / 2, p = 0.500 "
             "(cannot tell apart) & 10 & 1 \\\\") in tex
     assert "MARKED: reads what the fault emulation writes" in tex
