@@ -129,7 +129,8 @@ def _feed(h, value, seen: set[int]) -> None:
         h.update(b"]")
     elif isinstance(value, set | frozenset):
         _feed(h, sorted(value, key=repr), seen)
-    elif isinstance(value, type) or callable(value) and hasattr(value, "__qualname__"):
+    elif isinstance(value, type) or (callable(value) and hasattr(value, "__qualname__")):
+        # a class or a function: by its name, which the same code keeps across copies
         h.update(f"{getattr(value, '__module__', '')}.{value.__qualname__}".encode())
     elif id(value) in seen:
         h.update(b"<seen>")
