@@ -320,21 +320,14 @@ def _with_grid(corpus: Corpus) -> tuple[Mapping[str, Flight], pd.DataFrame]:
 
 
 #: the config settings every result and the published runs must share to be compared
-SCORING_SETTINGS = {
-    "scoring.deadline_s": ("scoring", "deadline_s"),
-    "subsets": ("subsets",),
-    "primary_subset": ("primary_subset",),
-    "calibration.group_by": ("calibration", "group_by"),
-    "calibration.margin_s": ("calibration", "margin_s"),
-    "stability.pools": ("stability", "pools"),
-    "stability.seed": ("stability", "seed"),
-    "stability.stable": ("stability", "stable"),
-    "stability.interval": ("stability", "interval"),
-}
+SCORING_SETTINGS = ("scoring.deadline_s", "subsets", "primary_subset", "calibration.group_by",
+                    "calibration.margin_s", "stability.pools", "stability.seed",
+                    "stability.stable", "stability.interval")
 
 
-def _setting(config: dict, keys: tuple):
-    for key in keys:
+def _setting(config: dict, name: str):
+    """The value of the dotted setting ``name`` in ``config`` (None where it is unset)."""
+    for key in name.split("."):
         config = (config or {}).get(key)
     return config
 
@@ -416,9 +409,8 @@ def _check_like(config: dict, deadline_s: float, subsets: list[str], manifest: p
     on the flights of ``manifest`` (``where`` named them), by alfa-bench ``version``;
     else the ValueError that names what differs."""
     mine = res.corpus.config
-    differs = [(k, _setting(mine, keys), _setting(config, keys))
-               for k, keys in SCORING_SETTINGS.items()
-               if _setting(mine, keys) != _setting(config, keys)]
+    differs = [(k, _setting(mine, k), _setting(config, k)) for k in SCORING_SETTINGS
+               if _setting(mine, k) != _setting(config, k)]
     if res.deadline_s != deadline_s:
         differs.append(("deadline_s", res.deadline_s, deadline_s))
     if list(res.subsets) != list(subsets):

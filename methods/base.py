@@ -233,10 +233,9 @@ def _sealed(method, forget: bool):
             out = method(self, *args, **kwargs)
         finally:
             _FITTING.discard(id(self))
-        learned = learned_state(self)
-        learned.pop("fit_digest_", None)
-        if forget and self.calibrated and type(self).fitted is Detector.fitted:
-            learned.pop("fit_report_", None)
+        learned = {n: v for n, v in learned_state(self).items()
+                   if n not in ("fit_digest_", "fit_report_")}
+        if self.calibrated and type(self).fitted is Detector.fitted:
             self.fit_report_ = json_ready(learned)
         self.fit_digest_ = _digest(learned)
         return out

@@ -35,6 +35,11 @@ MIN_SEGMENTS = 3
 CAP_LEVEL = 0.999
 
 
+def _flat(low, high):
+    """Whether values between ``low`` and ``high`` do not vary, to rounding."""
+    return high - low <= 1e-12 * np.maximum(1.0, np.maximum(np.abs(low), np.abs(high)))
+
+
 def _gumbel_unit(p: float) -> float:
     """The Gumbel law's quantile function in units of its scale: Q(p) = mu + beta g(p)."""
     return -math.log(-math.log(p))
@@ -69,7 +74,7 @@ def gumbel_threshold(maxima: np.ndarray, level: float) -> float:
     cap = q2 + (q3 - q1) * (_gumbel_unit(CAP_LEVEL) - _gumbel_unit(0.5)) / (
         _gumbel_unit(0.75) - _gumbel_unit(0.25))
     capped = np.minimum(maxima, cap)
-    if np.ptp(capped) <= 1e-12 * max(1.0, float(np.abs(capped).max())):
+    if _flat(capped.min(), capped.max()):
         raise CalibrationError(f"the {maxima.size} per-flight maxima are all "
                                f"{float(capped[0]):g} once capped: a score that does not "
                                "vary between fault-free flights gives no extreme-value "
@@ -114,7 +119,7 @@ def gumbel_thresholds(maxima: np.ndarray, counts: np.ndarray, level: float) -> n
         :func:`gumbel_threshold` does: then no pool can be fitted."""
     order = np.argsort(maxima)
     x = np.asarray(maxima, dtype=float)[order]
-    if x.size and (not np.isfinite(x).all() or np.ptp(x) <= 1e-12 * max(1.0, np.abs(x).max())):
+    if x.size and (not np.isfinite(x).all() or _flat(x[0], x[-1])):
         raise CalibrationError(f"the {x.size} per-flight maxima are not finite or do not "
                                "vary: no pool of them gives an extreme-value threshold")
     w = np.asarray(counts, dtype=float)[:, order]
@@ -143,9 +148,7 @@ def gumbel_thresholds(maxima: np.ndarray, counts: np.ndarray, level: float) -> n
         e = w * np.exp(-(y - low) / beta[:, None])
         gamma = low[:, 0] - beta * np.log(e.sum(axis=1) / m) + beta * _gumbel_unit(level)
     # a pool whose capped maxima do not vary has no law to fit, as gumbel_threshold says
-    drawn_max = np.where(w > 0, y, -np.inf).max(axis=1)
-    drawn_min = np.where(w > 0, y, np.inf).min(axis=1)
-    flat = drawn_max - drawn_min <= 1e-12 * np.maximum(1.0, np.abs(drawn_max))
+    flat = _flat(np.where(w > 0, y, np.inf).min(axis=1), np.where(w > 0, y, -np.inf).max(axis=1))
     flat |= ~np.isfinite(gamma)
     out[ok] = np.where(flat, np.nan, gamma)
     return out
@@ -187,6 +190,12 @@ class MaximaThresholds:
         self.fit_model(segments)
         # a fit starts from no learned attribute (Detector.fit): these are the model's
         self.model_ = tuple(learned_state(self))
+        self.maxima_, self.maxima_flights_ = self.segment_maxima(segments)
+        return self.rethreshold()
+
+    def segment_maxima(self, segments) -> tuple[dict, dict]:
+        """Per channel, the maxima of the current model's scores over ``segments`` and
+        the flight of each (a segment on which the channel never scores gives none)."""
         maxima = {c: [] for c in self.channels()}
         flights = {c: [] for c in self.channels()}
         for s in segments:
@@ -196,8 +205,7 @@ class MaximaThresholds:
                 if np.isfinite(column).any():
                     maxima[c].append(float(np.nanmax(column)))
                     flights[c].append(s.flight)
-        self.maxima_, self.maxima_flights_ = maxima, flights
-        return self.rethreshold()
+        return maxima, flights
 
     def rethreshold(self) -> MaximaThresholds:
         """:math:`\\gamma_c` from the fitted maxima, for ``false_alarm``; return self.

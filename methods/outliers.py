@@ -192,18 +192,16 @@ class OutlierModel(MaximaThresholds, Detector):
         if len(segments) < 2:
             raise CalibrationError(f"{self.channels()[0]}: {len(segments)} calibration "
                                    "segments; the out-of-sample maxima need two or more")
-        maxima, flights = [], []
+        channel = self.channels()[0]
+        maxima, flights = {channel: []}, {channel: []}
         for train, held in ((segments[0::2], segments[1::2]), (segments[1::2], segments[0::2])):
             self.fit_model(train)
-            for s in held:
-                score, _ = self.run(s)
-                if np.isfinite(score).any():
-                    maxima.append(float(np.nanmax(score)))
-                    flights.append(s.flight)
+            half, of = self.segment_maxima(held)
+            maxima[channel] += half[channel]
+            flights[channel] += of[channel]
         self.fit_model(segments)
-        self.model_ = ()
-        self.maxima_, self.maxima_flights_ = {self.channels()[0]: maxima}, {
-            self.channels()[0]: flights}
+        self.model_ = ()                   # the model is reported by fitted() below
+        self.maxima_, self.maxima_flights_ = maxima, flights
         return self.rethreshold()
 
     def fitted(self) -> dict:
@@ -211,9 +209,8 @@ class OutlierModel(MaximaThresholds, Detector):
         training rows and feature scaling."""
         out = super().fitted()
         out["model"] = {"library": self.library, "name": self.channels()[0],
-                        "params": {k: repr(v) if not isinstance(v, int | float | str | bool)
-                                   and v is not None else v
-                                   for k, v in _params(self.estimator_).items()},
+                        "params": {k: v if v is None or isinstance(v, int | float | str)
+                                   else repr(v) for k, v in _params(self.estimator_).items()},
                         "rows": self.rows_, "center": self.center_.tolist(),
                         "scale": self.scale_.tolist()}
         return out
