@@ -37,6 +37,7 @@ rule all:
         rules.tables.output,
         rules.index_page.output,
         rules.per_flight.output,
+        rules.protocol_steps.output,
         rules.deadline.output,
         rules.leakage.output,
         rules.ceiling.output,

@@ -43,7 +43,7 @@ from alfa_bench.methods import (
     run_detector,
 )
 
-from .held_out import GROUPINGS, TooFewGroupsError, check_held_out, folds, groups_of
+from .held_out import TooFewGroupsError, check_held_out, folds, group_labels, groups_of
 from .isolation import isolate
 from .provenance import provenance
 from .scoring import flight_outcome
@@ -85,6 +85,7 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
     """
     if detector is None:
         detector = make_detector(spec["detector"], spec.get("params"))
+    calibration = {**calibration, **spec.get("calibration", {})}
     train = manifest if calibrate_on is None else calibrate_on
     sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
     sha |= dict(zip(train["flight"], train["sha256"], strict=True))
@@ -106,7 +107,7 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
     except TooFewGroupsError as e:
         runner.uncalibrated([f for names in scored_by_fold.values() for f in names], e)
         return
-    group = dict(zip(train["flight"], train[GROUPINGS[calibration["group_by"]]].astype(str),
+    group = dict(zip(train["flight"], group_labels(train, calibration["group_by"]),
                      strict=True))
     for fold, (_, training) in by_fold.items():
         scored = scored_by_fold.pop(fold, [])

@@ -1,7 +1,9 @@
 """Leave-one-group-out folds: no flight is scored by a model or threshold that saw it.
 
 Each fold holds out one group of flights (a day, by default, since flights of one
-day share the aircraft's trim, wind and the segments of one recording) and
+day share the aircraft's trim, wind and the segments of one recording; or one
+recording, the flight name's timestamp, as a public study of ALFA does; or one
+flight) and
 calibrates on the fault-free data of every other flight with ground truth (or, for a
 supervised detector, on those flights whole, with their labels).
 :func:`check_held_out` checks, before every fit, that no segment comes from the
@@ -15,10 +17,18 @@ import pandas as pd
 from alfa_bench.methods import CalibrationError
 
 __all__ = ["GROUPINGS", "HeldOutError", "TooFewGroupsError", "check_held_out", "folds",
-           "groups_of"]
+           "group_labels", "groups_of"]
 
-#: manifest column that defines a group
-GROUPINGS = {"date": "date", "flight": "flight"}
+#: the manifest columns whose values, joined by "-", name a flight's group
+GROUPINGS = {"date": ("date",), "recording": ("date", "time"), "flight": ("flight",)}
+
+
+def group_labels(manifest: pd.DataFrame, group_by: str) -> pd.Series:
+    """Each flight's group under ``group_by`` (one of :data:`GROUPINGS`), as strings."""
+    if group_by not in GROUPINGS:
+        raise ValueError(f"group_by must be one of {sorted(GROUPINGS)}, got {group_by!r}")
+    columns = [manifest[c].astype(str) for c in GROUPINGS[group_by]]
+    return columns[0].str.cat(columns[1:], sep="-") if len(columns) > 1 else columns[0]
 
 
 class TooFewGroupsError(CalibrationError):
@@ -28,10 +38,8 @@ class TooFewGroupsError(CalibrationError):
 def folds(manifest: pd.DataFrame, group_by: str) -> dict[str, tuple[list[str], list[str]]]:
     """Group -> (flights it scores, flights that calibrate it), over flights with
     ground truth, in manifest order."""
-    if group_by not in GROUPINGS:
-        raise ValueError(f"group_by must be one of {sorted(GROUPINGS)}, got {group_by!r}")
     labelled = manifest[manifest["ground_truth"]]
-    groups = labelled[GROUPINGS[group_by]].astype(str).to_numpy()
+    groups = group_labels(labelled, group_by).to_numpy()
     found = len(dict.fromkeys(groups))
     if found < 2:
         raise TooFewGroupsError(f"calibration needs flights from at least two {group_by} groups; "
@@ -47,12 +55,11 @@ def groups_of(scored: pd.DataFrame, train: pd.DataFrame, group_by: str) -> pd.Se
     """The group of each flight of ``scored``, whose fold scores it: its own, but an
     injected flight's (``fault_source`` set) is its source's group in ``train``, so
     that it is scored by the fold that left its source out, whatever the grouping."""
-    own = scored[GROUPINGS[group_by]].astype(str)
+    own = group_labels(scored, group_by)
     if "fault_source" not in scored:
         return own
     source = scored["fault_source"].fillna("").astype(str)
-    of_source = dict(zip(train["flight"], train[GROUPINGS[group_by]].astype(str),
-                         strict=True))
+    of_source = dict(zip(train["flight"], group_labels(train, group_by), strict=True))
     injected = source != ""
     unknown = sorted(set(source[injected]) - set(of_source))
     if unknown:

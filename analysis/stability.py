@@ -197,10 +197,11 @@ def refit_first_alarms(spec: dict, flights, manifest: pd.DataFrame, calibration:
         training_segments,
     )
 
-    from .held_out import GROUPINGS, check_held_out, folds
+    from .held_out import check_held_out, folds, group_labels
 
-    group = dict(zip(manifest["flight"], manifest[GROUPINGS[calibration["group_by"]]]
-                     .astype(str), strict=True))
+    calibration = {**calibration, **spec.get("calibration", {})}
+    group = dict(zip(manifest["flight"], group_labels(manifest, calibration["group_by"]),
+                     strict=True))
     out: dict[str, list[float | None]] = {}
     segments: dict[str, list] = {}
     for fold, (scored, training) in folds(manifest, calibration["group_by"]).items():

@@ -12,7 +12,15 @@ from .errors import (
     UnknownSignalError,
     failure_row,
 )
-from .flight import FAULT_CLASSES, Fault, Flight, Topic, find_flights, load_flight
+from .flight import (
+    FAULT_CLASSES,
+    Fault,
+    Flight,
+    Topic,
+    find_flights,
+    load_flight,
+    parse_flight_name,
+)
 from .manifest import (
     SUBSETS,
     build_manifest,
@@ -38,7 +46,7 @@ __all__ = [
     "AlfaDataError", "DownloadError", "Fault", "Flight", "MissingFolderError",
     "MissingTopicError", "Sampled", "Signal", "StaleCacheError", "Topic", "UnknownSignalError",
     "build_manifest", "failure_row", "fetch_alfa", "find_flights", "load_cached",
-    "load_flight",
-    "name_subsets", "not_measured", "processed_dir", "read_manifest", "reads_actuators",
+    "load_flight", "name_subsets", "not_measured", "parse_flight_name", "processed_dir",
+    "read_manifest", "reads_actuators",
     "read_cached", "resolve_alfa_dir", "sample", "scan_flights", "series", "subset_flights",
 ]

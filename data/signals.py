@@ -129,6 +129,10 @@ SIGNALS: dict[str, Signal] = {
     # throttle is asked to make up
     "altitude_error": Signal("mavros-nav_info-errors", "field.alt_error", "setpoint", unit="m",
                              bounds=(-5000.0, 5000.0)),
+    # the autopilot's airspeed error (target minus its airspeed estimate, which is
+    # synthetic where the pitot is dead, so it is live on every flight), in cm/s as logged
+    "airspeed_error": Signal("mavros-nav_info-errors", "field.aspd_error", "setpoint",
+                             unit="cm/s", bounds=(-10000.0, 10000.0)),
     # body rates from the raw IMU, the freshest sensor in ALFA (~10 Hz, every row new)
     "roll_rate": Signal("mavros-imu-data_raw", "field.angular_velocity.x", "sensor",
                         unit="rad/s", bounds=_RATE_BOUNDS),
@@ -153,6 +157,14 @@ SIGNALS: dict[str, Signal] = {
                         unit="m/s", bounds=_SPEED_BOUNDS),
     "vel_up": Signal("mavros-local_position-velocity", "field.twist.linear.z", "sensor",
                      unit="m/s", bounds=_SPEED_BOUNDS),
+    # the autopilot's own velocity estimate (nav_info, NED as its frame_id says, rows
+    # ~19 Hz)
+    "nav_vel_north": Signal("mavros-nav_info-velocity", "field.meas_x", "sensor", unit="m/s",
+                            bounds=_SPEED_BOUNDS),
+    "nav_vel_east": Signal("mavros-nav_info-velocity", "field.meas_y", "sensor", unit="m/s",
+                           bounds=_SPEED_BOUNDS),
+    "nav_vel_down": Signal("mavros-nav_info-velocity", "field.meas_z", "sensor", unit="m/s",
+                           bounds=_SPEED_BOUNDS),
     "wind_east": Signal("mavros-wind_estimation", "field.twist.linear.x", "sensor",
                         unit="m/s", bounds=_SPEED_BOUNDS),
     "wind_north": Signal("mavros-wind_estimation", "field.twist.linear.y", "sensor",

@@ -169,6 +169,9 @@ def write_flight(processed: Path, name: str, *, duration_s: float = 80.0, rate_h
 TWIST_HEADER = ("%time,field.header.seq,field.header.stamp,field.header.frame_id,"
                 "field.twist.linear.x,field.twist.linear.y,field.twist.linear.z,"
                 "field.twist.angular.x,field.twist.angular.y,field.twist.angular.z")
+NAV_VELOCITY_HEADER = ("%time,field.header.seq,field.header.stamp,field.header.frame_id,"
+                       "field.coordinate_frame,field.des_x,field.des_y,field.des_z,"
+                       "field.meas_x,field.meas_y,field.meas_z")
 #: what a lost engine does to the synthetic energy from onset: the climb rate falls by
 #: this much (m/s) and the airspeed decays at this rate (m/s^2), down to 10 m/s
 ENGINE_CLIMB_LOSS, ENGINE_SPEED_DECAY = 2.0, 0.5
@@ -176,7 +179,8 @@ ENGINE_CLIMB_LOSS, ENGINE_SPEED_DECAY = 2.0, 0.5
 
 def energy_topics(folder: Path, name: str, duration_s: float, engine_onset_s: float | None,
                   rng: np.random.Generator) -> None:
-    """rel_alt and local_position-velocity at 4 Hz, wind_estimation at 2 Hz (ENU, m/s).
+    """rel_alt, local_position-velocity (ENU) and nav_info-velocity (NED) at 4 Hz,
+    wind_estimation at 2 Hz (ENU), m/s.
 
     The air-relative speed wanders about 16 m/s along a slowly turning heading, the
     climb rate about 0 (0.5 sin(0.1 t)), the wind holds (3, 2); the ground velocity is
@@ -195,6 +199,11 @@ def energy_topics(folder: Path, name: str, duration_s: float, engine_onset_s: fl
               [f"{a},{h!r}" for a, h in zip(ns.tolist(), height.tolist(), strict=True)])
     write_csv(folder / f"{name}-mavros-local_position-velocity.csv", TWIST_HEADER,
               [f"{a},{i},{a - 100_000},map,{e!r},{n!r},{c!r},0.0,0.0,0.0"
+               for i, (a, e, n, c) in enumerate(zip(ns.tolist(), east.tolist(), north.tolist(),
+                                                    climb.tolist(), strict=True))])
+    # the autopilot's own estimate of the same ground velocity (nav_info, NED)
+    write_csv(folder / f"{name}-mavros-nav_info-velocity.csv", NAV_VELOCITY_HEADER,
+              [f"{a + 8_000_000},{i},{a},NED,5,0.0,0.0,0.0,{n!r},{e!r},{-c!r}"
                for i, (a, e, n, c) in enumerate(zip(ns.tolist(), east.tolist(), north.tolist(),
                                                     climb.tolist(), strict=True))])
     wt = t[::2]
@@ -225,10 +234,14 @@ def errors_topic(folder: Path, name: str, t_ns: np.ndarray, rate_hz: float,
     n = t_ns.size
     alt = rng.uniform(-10, 10) + arx_response(rng.normal(0, 1, n), 0.99, 0.05,
                                               np.zeros(n))
+    # the airspeed error (cm/s) swings slowly about 0, drawn from no generator so that
+    # every other synthetic value stays what it was
+    aspd = 50.0 * np.sin(0.05 * (t_ns - T0_NS) * 1e-9)
     seq = np.arange(n) + 500
     write_csv(folder / f"{name}-mavros-nav_info-errors.csv", ERRORS_HEADER,
-              [f"{t},{s},{t - 120_000},NED,{a!r},0.0,0.0,10"
-               for t, s, a in zip(t_ns.tolist(), seq.tolist(), alt.tolist(), strict=True)])
+              [f"{t},{s},{t - 120_000},NED,{a!r},{v!r},0.0,10"
+               for t, s, a, v in zip(t_ns.tolist(), seq.tolist(), alt.tolist(), aspd.tolist(),
+                                     strict=True)])
 
 
 def rename_flight(folder: Path, name: str) -> Path:

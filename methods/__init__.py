@@ -55,6 +55,8 @@ BUILTIN_ENTRIES = {
     "kalman_okid": "kalman_okid:KalmanOkid",
     "residual_bank": "residual_bank:ResidualBank",
     "learned_fusion": "learned_fusion:LearnedFusion",
+    "residual_logistic": "residual_logistic:ResidualLogistic",
+    "residual_logistic_published": "residual_logistic:ResidualLogisticPublished",
     "nested_selection": "nested_selection:NestedSelection",
     "coincidence": "coincidence:Coincidence",
     "emulation_oracle": "emulation_oracle:EmulationOracle",
@@ -81,12 +83,13 @@ def plugins() -> dict[str, type[Detector]]:
     return found
 
 
+def _builtin_class(name: str) -> type[Detector]:
+    module, cls = BUILTIN_ENTRIES[name].split(":")
+    return getattr(importlib.import_module(f".{module}", __name__), cls)
+
+
 def _builtin() -> dict[str, type[Detector]]:
-    found = {}
-    for name, value in BUILTIN_ENTRIES.items():
-        module, cls = value.split(":")
-        found[name] = getattr(importlib.import_module(f".{module}", __name__), cls)
-    return found
+    return {name: _builtin_class(name) for name in BUILTIN_ENTRIES}
 
 
 def __getattr__(name: str):
@@ -113,12 +116,18 @@ def detector_name(detector: Detector) -> str:
 
 
 def make_detector(name: str, params: dict | None = None) -> Detector:
-    """Build the registered detector ``name`` with ``params``."""
-    registry = __getattr__("REGISTRY")
-    try:
-        cls = registry[name]
-    except KeyError:
-        raise KeyError(f"unknown detector {name!r}; registered: {sorted(registry)}") from None
+    """Build the registered detector ``name`` with ``params``. A built-in one imports
+    its own module only: every job builds one, and the detector modules import numba,
+    scipy and scikit-learn."""
+    if name in BUILTIN_ENTRIES:
+        cls = _builtin_class(name)
+    else:
+        registry = __getattr__("REGISTRY")
+        try:
+            cls = registry[name]
+        except KeyError:
+            raise KeyError(f"unknown detector {name!r}; registered: "
+                           f"{sorted(registry)}") from None
     params = dict(params or {})
     signature = inspect.signature(cls.__init__).parameters
     for key, value in params.items():

@@ -485,11 +485,15 @@ class Labelled:
         Fault onset on the flight clock; None for a fault-free flight.
     fault_class : str
         ``none`` for a fault-free flight.
+    emergency_trajectory : bool
+        The flight switches to an emergency trajectory at onset: its commands carry
+        the label from then on.
     """
 
     sampled: Sampled
     onset_s: float | None
     fault_class: str
+    emergency_trajectory: bool = False
 
     @property
     def flight(self) -> str:
@@ -692,7 +696,8 @@ def labelled_segments(detector: Detector, flights: list[Flight]) -> list[Labelle
             log.info("%s left out of training: %s not measured", flight.id, list(dead))
             continue
         segments.append(Labelled(sample(flight, detector.signals(), detector.rate_hz),
-                                 flight.fault.onset_s, flight.fault.fault_class))
+                                 flight.fault.onset_s, flight.fault.fault_class,
+                                 flight.emergency_trajectory))
     return segments
 
 

@@ -193,6 +193,25 @@ class MaximaThresholds:
         self.maxima_, self.maxima_flights_ = self.segment_maxima(segments)
         return self.rethreshold()
 
+    def fit_out_of_sample(self, segments, splits) -> MaximaThresholds:
+        """:meth:`fit` with maxima out of sample: per ``(training, held)`` of ``splits``,
+        the model fitted on ``training`` gives the maxima of the ``held`` segments (a
+        model may score its own training data low); then the model is fitted on every
+        one of ``segments``, and the thresholds set. A model a subclass fits this way
+        is its own to report in :meth:`fitted` (``model_`` is empty)."""
+        maxima = {c: [] for c in self.channels()}
+        flights = {c: [] for c in self.channels()}
+        for training, held in splits:
+            self.fit_model(training)
+            got, of = self.segment_maxima(held)
+            for c in maxima:
+                maxima[c] += got[c]
+                flights[c] += of[c]
+        self.fit_model(segments)
+        self.model_ = ()
+        self.maxima_, self.maxima_flights_ = maxima, flights
+        return self.rethreshold()
+
     def segment_maxima(self, segments) -> tuple[dict, dict]:
         """Per channel, the maxima of the current model's scores over ``segments`` and
         the flight of each (a segment on which the channel never scores gives none)."""

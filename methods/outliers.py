@@ -192,17 +192,8 @@ class OutlierModel(MaximaThresholds, Detector):
         if len(segments) < 2:
             raise CalibrationError(f"{self.channels()[0]}: {len(segments)} calibration "
                                    "segments; the out-of-sample maxima need two or more")
-        channel = self.channels()[0]
-        maxima, flights = {channel: []}, {channel: []}
-        for train, held in ((segments[0::2], segments[1::2]), (segments[1::2], segments[0::2])):
-            self.fit_model(train)
-            half, of = self.segment_maxima(held)
-            maxima[channel] += half[channel]
-            flights[channel] += of[channel]
-        self.fit_model(segments)
-        self.model_ = ()                   # the model is reported by fitted() below
-        self.maxima_, self.maxima_flights_ = maxima, flights
-        return self.rethreshold()
+        halves = segments[0::2], segments[1::2]
+        return self.fit_out_of_sample(segments, [halves, halves[::-1]])
 
     def fitted(self) -> dict:
         """The maxima and thresholds, and the model: its library, name, parameters,

@@ -61,6 +61,7 @@ import numpy as np
 import pandas as pd
 
 from alfa_bench.analysis.blocks import FAULT_ORDER
+from alfa_bench.analysis.public_study import STUDY_SUMMARY, study_counts
 from alfa_bench.analysis.reference import ICRA2019_SUMMARY
 from alfa_bench.data import SIGNALS
 from alfa_bench.render import latex_escape
@@ -96,12 +97,15 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.Dat
                   primary: str | None = None,
                   ceiling: pd.DataFrame | None = None,
                   calibration: pd.DataFrame | None = None,
-                  stability: dict | None = None) -> dict[str, str]:
+                  stability: dict | None = None,
+                  study: pd.DataFrame | None = None) -> dict[str, str]:
     """Every quotable number, as text, by key (see the module docstring). A configured
     run (``methods``) with no score on a subset (``subsets``), because every flight of
     it was excluded, quotes "n/a". ``sensors`` holds the ``detectability``,
     ``isolation_sensors`` and ``isolation_actuators`` tables; ``primary`` is the
-    headline subset; ``ceiling`` the detectability ceiling's table."""
+    headline subset; ``ceiling`` the detectability ceiling's table; ``study`` the public
+    study's reproduction against its published table
+    (:func:`~alfa_bench.analysis.public_study.against_study`)."""
     out = {f"{k}:{m}:{s}": "n/a" for k in _PER_RUN for m in methods for s in subsets}
     out |= {f"paper:{k}": (_pct if k in ("precision", "recall", "accuracy") else _sec)(
         ICRA2019_SUMMARY[key])
@@ -153,6 +157,7 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.Dat
         for m, n in comparison.groupby("method")["configurations"].max().items():
             out[f"configurations:{m}"] = str(int(n))
     out |= _calibration_numbers(calibration)
+    out |= _study_numbers(study)
     out |= {"pools": str(stability["pools"]) if stability else "n/a",
             "stableshare": f"{100 * stability['stable']:g}" if stability else "n/a"}
     out |= _ceiling_numbers(ceiling, [*dict.fromkeys([*subsets, *comparison["subset"]])])
@@ -187,6 +192,23 @@ def _calibration_numbers(calibration: pd.DataFrame | None) -> dict[str, str]:
     return {"calflights": f"{flights.min()}-{flights.max()}",
             "calhours": f"{hours.min():.2f}-{hours.max():.2f}",
             "callevel": f"{calibration['smallest_level'].max():.3f}"}
+
+
+def _study_numbers(study: pd.DataFrame | None) -> dict[str, str]:
+    """The reproduction against the public study's table: flights with its outcome
+    (``studysame``), and TP / FP / FN / TN by its rule, ours (``studyours``), the
+    study's on the same flights (``studytheirs``) and on all of its own
+    (``studyall``, over ``studyflights``)."""
+    out = {"studyall": _counts(STUDY_SUMMARY), "studyflights": str(STUDY_SUMMARY["flights"])}
+    if study is None or study.empty:
+        return out | dict.fromkeys(("studysame", "studyours", "studytheirs"), "n/a")
+    return out | {"studysame": f"{int(study['same'].sum())} of {len(study)}",
+                  "studyours": _counts(study_counts(study["outcome"])),
+                  "studytheirs": _counts(study_counts(study["study_outcome"]))}
+
+
+def _counts(c: dict) -> str:
+    return " / ".join(str(c[k]) for k in ("tp", "fp", "fn", "tn"))
 
 
 def _ceiling_numbers(ceiling: pd.DataFrame | None, subsets) -> dict[str, str]:

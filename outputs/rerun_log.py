@@ -47,7 +47,7 @@ log = logging.getLogger(__name__)
 TIMELINE = "flight_time"
 _APPLICATION = "alfa-bench"
 _GROUPS = ("attitude", "attitude_error", "rates", "specific_force", "servos", "airspeed",
-           "altitude")
+           "airspeed_error", "altitude")
 _RED = (220, 40, 40)
 
 
@@ -58,8 +58,9 @@ def signal_group(name: str) -> str:
         return "servos"      # the outputs the fault emulation writes, throttle included
     if sig.unit == "deg":
         return "attitude_error" if sig.minus else "attitude"
+    # the autopilot's airspeed error is logged in cm/s: a view of its own, not m/s's
     return {"rad/s": "rates", "m/s^2": "specific_force", "m/s": "airspeed",
-            "m": "altitude"}[sig.unit]
+            "cm/s": "airspeed_error", "m": "altitude"}[sig.unit]
 
 
 def blueprint(methods: list[str], groups: list[str], title: str = "",

@@ -29,6 +29,7 @@ rule paper_sources:
         leakage="results/tables/leakage.csv",
         ceiling="results/tables/ceiling.csv",
         calibration="results/tables/calibration.csv",
+        against_study="results/tables/against_study.csv",
         tex=PAPER_DIR / "paper.tex",
         markdown=PAPER_DIR / "paper.template.md",
     output:

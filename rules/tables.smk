@@ -93,8 +93,10 @@ rule per_flight:
         md="results/tables/per_flight.md",
         parquet="results/tables/per_flight.parquet",
         records="results/tables/detections.parquet",
+        against_study="results/tables/against_study.csv",
     params:
         deadline_s=config["scoring"]["deadline_s"],
+        study_run=config.get("public_study", {}).get("reproduction"),
     resources:
         **JOB_RESOURCES,
     log:
@@ -103,6 +105,27 @@ rule per_flight:
         "results/benchmarks/per_flight.tsv"
     script:
         "../scripts/per_flight.py"
+
+
+# From a public study's protocol to this project's, one change at a time
+rule protocol_steps:
+    input:
+        manifest="results/flights.csv",
+        per_flight="results/tables/per_flight.csv",
+    output:
+        csv="results/tables/protocol_steps.csv",
+        md="results/tables/protocol_steps.md",
+    params:
+        steps=config.get("public_study", {}).get("steps", []),
+        primary=PRIMARY,
+        deadline_s=config["scoring"]["deadline_s"],
+        stable=config["stability"]["stable"],
+    resources:
+        **JOB_RESOURCES,
+    log:
+        "results/logs/protocol_steps.log",
+    script:
+        "../scripts/protocol_steps.py"
 
 
 rule runtime:

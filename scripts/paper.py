@@ -18,7 +18,8 @@ numbers = paper_numbers(read_table(sm.input.comparison), read_table(sm.input.swe
                             "detectability", "isolation_sensors", "isolation_actuators")},
                         ceiling=read_table(sm.input.ceiling),
                         calibration=read_table(sm.input.calibration),
-                        stability=sm.config["stability"])
+                        stability=sm.config["stability"],
+                        study=read_table(sm.input.against_study))
 unknown = latex_keys(Path(sm.input.tex).read_text()) - set(numbers)
 if unknown:
     raise KeyError(f"{sm.input.tex} quotes results no run defines: {sorted(unknown)}")

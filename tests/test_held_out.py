@@ -10,7 +10,7 @@ import yaml
 
 import alfa_bench.analysis.detections as detections
 from alfa_bench.analysis import detect_all, folds
-from alfa_bench.analysis.held_out import HeldOutError
+from alfa_bench.analysis.held_out import HeldOutError, group_labels
 from alfa_bench.methods import REGISTRY, Detector, Labelled, make_detector
 
 CONFIG = yaml.safe_load((Path(__file__).parent.parent / "config/config.yaml").read_text())
@@ -77,25 +77,28 @@ def spied(monkeypatch, detector):
     return seen
 
 
-def assert_held_out(records, seen, manifest):
-    date = dict(zip(manifest["flight"], manifest["date"], strict=True))
+def assert_held_out(records, seen, manifest, group_by="date"):
+    group = dict(zip(manifest["flight"], group_labels(manifest, group_by), strict=True))
     fits = dict(zip(dict.fromkeys(r["calibration"]["fold"] for r in records), seen,
                     strict=True))
     for r in records:
         fold = r["calibration"]["fold"]
-        assert date[r["flight"]] == fold
-        assert fits[fold] and all(date[f] != fold for f in fits[fold]), (r["flight"], fold)
+        assert r["calibration"]["group_by"] == group_by
+        assert group[r["flight"]] == fold
+        assert fits[fold] and all(group[f] != fold for f in fits[fold]), (r["flight"], fold)
         assert set(r["calibration"]["flights"]) == fits[fold]
 
 
 @pytest.mark.parametrize("run", CALIBRATED)
-def test_no_fit_of_a_configured_run_sees_the_date_it_scores(run, corpus_flights, corpus_manifest,
-                                                            monkeypatch):
+def test_no_fit_of_a_configured_run_sees_the_group_it_scores(run, corpus_flights,
+                                                             corpus_manifest, monkeypatch):
+    """Each run's own grouping, where it sets one (the public study's: by recording)."""
     spec = CONFIG["methods"][run]
     seen = spied(monkeypatch, make_detector(spec["detector"], spec.get("params")))
     records = [r for r, _ in detect_all(run, spec, corpus_flights, corpus_manifest, CALIBRATION)]
     assert records and len(seen) == len({r["calibration"]["fold"] for r in records})
-    assert_held_out(records, seen, corpus_manifest)
+    assert_held_out(records, seen, corpus_manifest,
+                    spec.get("calibration", {}).get("group_by", "date"))
     # only a run that declares it learns from labels (a nested selection) gets them
     assert all(r["calibration"]["supervised"] == REGISTRY[spec["detector"]].supervised
                for r in records)
@@ -128,3 +131,17 @@ def test_a_fold_that_lets_the_scored_date_in_stops_the_run(corpus_flights, corpu
         with pytest.raises(HeldOutError, match="scored group"):
             list(detect_all("leaky", spec, corpus_flights, corpus_manifest, CALIBRATION,
                             failures=[]))
+
+
+def test_a_recording_is_the_flight_names_timestamp_and_its_parts_share_a_fold(
+        corpus_manifest):
+    by_recording = folds(corpus_manifest, "recording")
+    labels = group_labels(corpus_manifest, "recording")
+    assert set(by_recording) == set(labels[corpus_manifest["ground_truth"]])
+    for name, (scored, training) in by_recording.items():
+        assert all(f.startswith(f"carbonZ_{name}_") for f in scored)
+        assert not any(f.startswith(f"carbonZ_{name}_") for f in training)
+    # the synthetic corpus has two recordings of 2018-10-05: one fold each, not one
+    assert len(by_recording) > len(folds(corpus_manifest, "date"))
+    with pytest.raises(ValueError, match="recording"):
+        folds(corpus_manifest, "day")

@@ -129,3 +129,10 @@ def test_a_recording_merged_from_method_parts_equals_the_one_written_whole(
                            str(tmp_path / "whole.rrd"), str(tmp_path / "merged.rrd")],
                           capture_output=True, text=True)
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+
+
+def test_every_signal_has_a_view_of_its_own_unit():
+    from alfa_bench.data import SIGNALS as CATALOGUE
+    from alfa_bench.outputs.rerun_log import _GROUPS, signal_group
+
+    assert {signal_group(name) for name in CATALOGUE} <= set(_GROUPS)

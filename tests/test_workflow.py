@@ -405,7 +405,8 @@ def test_small_and_one_sided_flight_sets_run_to_the_end(specs, why, tmp_path):
 
 
 @pytest.mark.parametrize("config, message", [
-    ("calibration: {group_by: week, margin_s: 1.0}", "'week' is not one of ['date', 'flight']"),
+    ("calibration: {group_by: week, margin_s: 1.0}",
+     "'week' is not one of ['date', 'recording', 'flight']"),
     ("strict: maybe", "'maybe' is not of type 'boolean'"),
     ("methods: {x: {detector: rls_arx_zscor}}", "config methods.x: \"unknown detector"),
     ("methods: {x: {detector: rls_arx_zscore, params: {zthreshold: 3}}}",
