@@ -36,7 +36,9 @@ from alfa_bench.methods import (
     Fork,
     Trace,
     clone,
+    continue_forks,
     fault_free_segments,
+    fork_for,
     forks,
     labelled_segments,
     make_detector,
@@ -95,7 +97,8 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
         runner.fitted = fitted
     if not detector.calibrated:
         runner.fitted[""] = runner.detector
-        for name in manifest.loc[manifest["ground_truth"], "flight"]:
+        runner.scored = manifest.loc[manifest["ground_truth"], "flight"].tolist()
+        for name in runner.scored:
             if (out := runner.record(name)) is not None:
                 yield out
         return
@@ -155,7 +158,8 @@ class _FoldRunner:
     An injected flight is its source up to its onset, so the fitted detector is run
     over each source once per fold, up to every onset injected into it
     (:func:`~alfa_bench.methods.forks`), and each injected flight continues from the
-    fork at its onset."""
+    fork at its onset: the fold's flights injected into one source all in one call
+    (:func:`~alfa_bench.methods.continue_forks`)."""
 
     def __init__(self, method: str, spec: dict, detector: Detector,
                  flights: Mapping[str, Flight], sha: dict, calibration: dict,
@@ -169,6 +173,10 @@ class _FoldRunner:
         # each fold's fitted clone of ``detector``, by fold
         self.fitted: dict[str, Detector] = {}
         self.forks: dict[str, dict[float, Fork]] = {}
+        # the flights the current fold scores, and the scores continued from a source's
+        # forks for those injected into it (continue_forks), until recorded
+        self.scored: list[str] = []
+        self.continued: dict = {}
         # the fold's pool thresholds (pools, channels), or None
         self.pools: np.ndarray | None = None
 
@@ -195,9 +203,14 @@ class _FoldRunner:
         if source not in self.forks:
             self.forks[source] = self.guarded("detect", source, lambda: forks(
                 self.detector, self.flights[source], onsets)) or {}
+            # the fold's flights injected into this source, scored in one call
+            self.continued = continue_forks(self.detector, [
+                self.flights[n] for n in self.scored
+                if self.sources.get(n, ("",))[0] == source and n not in self.failed],
+                self.forks[source])
         return self.guarded("detect", name, lambda: detection_record(
             self.method, self.spec, self.detector, self.flights[name], self.sha, info,
-            forked=self.forks[source]))
+            forked=self.forks[source], continued=self.continued.pop(name, None)))
 
     def uncalibrated(self, names: list[str], error: CalibrationError) -> None:
         if self.failures is None:
@@ -226,6 +239,7 @@ class _FoldRunner:
         data = [s for f in used for s in segments[f]]
         check_held_out(data, fold, scored, group)
         self.forks = {}                # run by the previous fold's fit
+        self.scored, self.continued = scored, {}
         self.pools = None
         try:
             detector.fit(data)
@@ -290,6 +304,7 @@ def calibration_failure(flight: str, method: str, error: CalibrationError,
 def detection_record(method: str, spec: dict, detector: Detector, flight: Flight,
                      sha256: dict[str, str], calibration: dict | None = None,
                      forked: dict[float, Fork] | None = None,
+                     continued: tuple | None = None,
                      pools: np.ndarray | None = None) -> tuple[dict, Trace]:
     """Run ``detector`` (fitted if calibrated) on ``flight``: its record and trace.
     ``sha256`` maps flights to their checksums; the record's provenance gives those of
@@ -297,7 +312,8 @@ def detection_record(method: str, spec: dict, detector: Detector, flight: Flight
 
     With ``forked`` (an injected flight: :func:`~alfa_bench.methods.forks` of its
     source, by time), the run continues from the latest fork at or before the onset,
-    and keeps no probes (an injected flight has no trace written).
+    and keeps no probes (an injected flight has no trace written); with ``continued``
+    (:func:`~alfa_bench.methods.continue_forks` of the flight), its scores are those.
 
     With ``pools`` (thresholds per calibration pool and channel), the record's
     ``stability`` holds the first alarm under each (:func:`~.stability.
@@ -308,8 +324,8 @@ def detection_record(method: str, spec: dict, detector: Detector, flight: Flight
     if forked is None:
         trace = run_detector(detector, flight, probes=True)
     else:
-        at = max((t for t in forked if onset is not None and t <= onset), default=None)
-        trace = run_detector(detector, flight, fork=forked.get(at))
+        trace = run_detector(detector, flight, fork=fork_for(forked, onset),
+                             continued=continued)
     first = trace.first_alarm_s()
     outputs = dict(zip(trace.channels, detector.channel_outputs(), strict=True))
     outcome = flight_outcome(onset, first)

@@ -25,8 +25,10 @@ from .base import (
     StaleStateError,
     Trace,
     clone,
+    continue_forks,
     fault_free_segments,
     fit_token,
+    fork_for,
     forks,
     labelled_segments,
     run_detector,
@@ -38,9 +40,10 @@ from .extremes import MaximaThresholds
 
 __all__ = ["BUILTIN", "BUILTIN_ENTRIES", "DEFAULT_RATE_HZ", "FAMILIES", "PLUGIN_GROUP", "REGISTRY",
            "CalibrationError", "Detector", "Fork", "Labelled", "MaximaThresholds",
-           "NotFittedError", "PairDetector", "StaleStateError", "Trace", "clone", "detector_name",
-           "fault_free_segments", "fit_token", "forks", "labelled_segments", "make_detector",
-           "plugins", "run_detector", "skipped_channels", "source_digest", "training_segments"]
+           "NotFittedError", "PairDetector", "StaleStateError", "Trace", "clone", "continue_forks",
+           "detector_name", "fault_free_segments", "fit_token", "fork_for", "forks",
+           "labelled_segments", "make_detector", "plugins", "run_detector", "skipped_channels",
+           "source_digest", "training_segments"]
 
 #: the entry-point group third-party detectors register under
 PLUGIN_GROUP = "alfa_bench.methods"

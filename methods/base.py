@@ -62,13 +62,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from alfa_bench.data import Flight, Sampled, not_measured, sample
+from alfa_bench.data import AlfaDataError, Flight, Sampled, not_measured, sample
 
 __all__ = ["DEFAULT_RATE_HZ", "FAMILIES", "CalibrationError", "Detector", "Fork", "Labelled",
            "NotFittedError", "PairDetector", "StaleStateError", "Trace", "clone",
-           "fault_free_segments", "fit_token", "forks", "json_ready", "labelled_segments",
-           "learned_state", "run_detector", "skipped_channels", "source_digest",
-           "training_segments"]
+           "continue_forks", "fault_free_segments", "fit_token", "fork_for", "forks",
+           "json_ready", "labelled_segments", "learned_state", "run_detector",
+           "skipped_channels", "source_digest", "training_segments"]
 
 log = logging.getLogger(__name__)
 
@@ -424,6 +424,14 @@ class Detector(ABC):
                 kept[k] = list(self.probes().values())
         return score, {name: kept[:, i] for i, name in enumerate(names)}
 
+    def run_many(self, items: list[tuple[Sampled, int, object]], probes: bool = False
+                 ) -> list[tuple[np.ndarray, dict]]:
+        """:meth:`run` of each ``(s, start, state)``: the continuations of many flights
+        from their forks (:func:`continue_forks`). One :meth:`run` each by default; a
+        detector whose model costs more a call than a row overrides it to score them
+        all in one call (the contract test checks it gives each run's scores)."""
+        return [self.run(s, probes, start, state) for s, start, state in items]
+
     def _wrong_scores(self, x: np.ndarray, fresh: np.ndarray) -> ValueError | None:
         """Where :meth:`update` returns other than one score per channel, the error that
         says so (the step is taken again on a copy); None where it does not."""
@@ -599,15 +607,20 @@ class Fork:
                 and np.array_equal(s.x[:k], self.sampled.x, equal_nan=True)
                 and np.array_equal(s.fresh[:k], self.sampled.fresh))
 
+    def check(self, detector: Detector) -> None:
+        """Raise :class:`StaleStateError` unless ``detector`` is fitted and configured as
+        the one that ran these steps."""
+        if fit_token(detector) != self.token:
+            raise StaleStateError(f"{type(detector).__name__}: the fork was run under "
+                                  "another fit or other parameters; fork again")
+
     def continued(self, detector: Detector, s: Sampled, probes: bool
                   ) -> tuple[np.ndarray, dict]:
         """``detector``'s scores and probes over ``s`` (a flight :meth:`shared_by`
         accepts), these steps' included, running only the steps after them. A
         detector fitted or configured otherwise than the one that ran them raises
         :class:`StaleStateError`."""
-        if fit_token(detector) != self.token:
-            raise StaleStateError(f"{type(detector).__name__}: the fork was run under "
-                                  "another fit or other parameters; fork again")
+        self.check(detector)
         more, more_kept = detector.run(s, probes, start=self.sampled.t.size,
                                        state=self.state)
         return (np.vstack([self.score, more]),
@@ -632,22 +645,57 @@ def forks(detector: Detector, flight: Flight, times_s, probes: bool = False
     return out
 
 
+def fork_for(forked: dict[float, Fork], onset_s: float | None) -> Fork | None:
+    """Of ``forked`` (:func:`forks`), the fork a flight with its onset at ``onset_s``
+    continues from: the latest at or before the onset; None if there is none."""
+    at = max((t for t in forked if onset_s is not None and t <= onset_s), default=None)
+    return forked.get(at)
+
+
+def continue_forks(detector: Detector, flights: list[Flight], forked: dict[float, Fork]
+                   ) -> dict[str, tuple[Sampled, np.ndarray, dict]]:
+    """Each of ``flights`` that shares its fork's steps (:func:`fork_for`), sampled and
+    scored from its fork, all in one :meth:`Detector.run_many` call: flight -> (its
+    samples, its scores, no probes). A flight that cannot be sampled or shares no
+    fork is left out, for :func:`run_detector` to run (or fail) on its own."""
+    todo = []
+    for flight in flights:
+        fork = fork_for(forked, flight.fault.onset_s if flight.fault else None)
+        try:
+            s = sample(flight, detector.signals(), detector.rate_hz)
+        except AlfaDataError:
+            continue
+        if fork is not None and fork.shared_by(s, probes=False):
+            fork.check(detector)
+            todo.append((flight.id, s, fork))
+    if not todo:
+        return {}
+    done = detector.run_many([(s, fork.sampled.t.size, fork.state) for _, s, fork in todo])
+    return {name: (s, np.vstack([fork.score, more]), {})
+            for (name, s, fork), (more, _) in zip(todo, done, strict=True)}
+
+
 def run_detector(detector: Detector, flight: Flight, probes: bool = False,
-                 fork: Fork | None = None) -> Trace:
+                 fork: Fork | None = None,
+                 continued: tuple[Sampled, np.ndarray, dict] | None = None) -> Trace:
     """Run ``detector`` causally over ``flight``, from a fresh state; with ``probes``,
     keep :meth:`Detector.probes` of every step. Channels on signals the flight does not
     measure are skipped (:func:`skipped_channels`).
 
     With ``fork``, a flight that begins with the fork's steps continues from its state
     instead: the same trace, without running those steps again. One that does not (or
-    a fork without the probes asked for) runs from a fresh state."""
+    a fork without the probes asked for) runs from a fresh state. With ``continued``
+    (:func:`continue_forks` of this flight), its scores are already computed."""
     # first: an unfitted calibrated detector stops here, on NotFittedError
     threshold = np.asarray(detector.thresholds(), dtype=float)
-    s = sample(flight, detector.signals(), detector.rate_hz)
-    if fork is not None and fork.shared_by(s, probes):
-        score, kept = fork.continued(detector, s, probes)
+    if continued is not None:
+        s, score, kept = continued
     else:
-        score, kept = detector.run(s, probes)
+        s = sample(flight, detector.signals(), detector.rate_hz)
+        if fork is not None and fork.shared_by(s, probes):
+            score, kept = fork.continued(detector, s, probes)
+        else:
+            score, kept = detector.run(s, probes)
     skipped = skipped_channels(detector, not_measured(flight, detector.signals()))
     if skipped:
         score[:, [detector.channels().index(ch) for ch in skipped]] = np.nan

@@ -47,7 +47,7 @@ from pathlib import Path
 import numpy as np
 
 from alfa_bench.data import SIGNALS, load_flight, sample
-from alfa_bench.data.synthetic import write_corpus
+from alfa_bench.data.synthetic import rename_flight, write_corpus
 
 from .base import (
     FAMILIES,
@@ -55,6 +55,7 @@ from .base import (
     Detector,
     NotFittedError,
     StaleStateError,
+    continue_forks,
     fit_token,
     forks,
     run_detector,
@@ -237,6 +238,29 @@ def check_forked_run_equals_run(detector: Detector) -> None:
     assert not np.array_equal(whole.score, run_detector(d, flight).score, equal_nan=True)
 
 
+def check_many_continued_runs_equal_each_run(detector: Detector) -> None:
+    """:meth:`~.base.Detector.run_many` over flights continued from their forks
+    (:func:`~.base.continue_forks`, as the injected grid is scored) gives each one's
+    :meth:`~.base.Detector.run` from its fork, and the run from t = 0. Flights here: the
+    check flight, scrambled after 0.6 and after 0.8 of its length, each continued from
+    its fork at 0.3 or 0.6. A detector whose snapshot is None: skipped."""
+    d = _fitted(detector)
+    flight = _flight()
+    at = forks(d, flight, [0.3 * flight.duration_s, 0.6 * flight.duration_s])
+    if not at:
+        _skip("its snapshot() is None: forked runs run from t = 0")
+    with tempfile.TemporaryDirectory() as tmp:
+        others = [load_flight(rename_flight(
+            _scrambled_after(flight, share * flight.duration_s, Path(tmp) / str(share)),
+            _FLIGHT.replace("_1_", f"_{i + 2}_"))) for i, share in enumerate((0.6, 0.8))]
+    for forked in ({t: f} for t, f in at.items()):
+        continued = continue_forks(d, others, forked)
+        assert sorted(continued) == sorted(o.id for o in others)
+        for other in others:
+            np.testing.assert_allclose(continued[other.id][1], run_detector(d, other).score,
+                                       rtol=1e-9, atol=1e-9)
+
+
 def check_rethreshold_equals_fit(detector: Detector) -> None:
     """For each of its :attr:`~.base.Detector.threshold_params`, a fitted detector given
     another value and :meth:`~.base.Detector.rethreshold` equals one fitted with it:
@@ -378,6 +402,7 @@ CHECKS = (
     check_probes_are_named_once_and_do_not_change_the_run,
     check_batch_run_equals_streaming,
     check_forked_run_equals_run,
+    check_many_continued_runs_equal_each_run,
     check_rethreshold_equals_fit,
     check_a_refit_is_a_fresh_fit,
     check_maxima_that_do_not_vary_cannot_calibrate,

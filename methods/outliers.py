@@ -211,17 +211,28 @@ class OutlierModel(MaximaThresholds, Detector):
         """The scores of steps ``start:`` in one call of the model. A step's score reads
         the window before it and the frozen model only, so a run continued from a
         :meth:`snapshot` after ``start`` steps scores just the steps after them."""
+        return self.run_many([(s, start, state)], probes)[0]
+
+    def run_many(self, items: list[tuple[Sampled, int, object]], probes: bool = False
+                 ) -> list[tuple[np.ndarray, dict]]:
+        """:meth:`run` of each ``(s, start, state)``, every row of them in one call of
+        the model."""
         self._check_fitted("estimator_")
-        if state is not None and state != self.snapshot():
+        if any(state is not None and state != self.snapshot() for _, _, state in items):
             raise StaleStateError(f"{type(self).__name__}: the state to continue from was "
                                   "taken under another fit or other parameters")
-        first = max(start - self._width() + 1, 0)
-        f = self._features(s.since(first))[start - first:]
-        score = np.full(s.t.size - start, np.nan)
+        features = []
+        for s, start, _ in items:
+            first = max(start - self._width() + 1, 0)
+            features.append(self._features(s.since(first))[start - first:])
+        f = np.vstack(features)
+        score = np.full(f.shape[0], np.nan)
         ok = ~np.isnan(f).any(axis=1)
         if ok.any():
             score[ok] = self._score(self.estimator_, (f[ok] - self.center_) / self.scale_)
-        return score[:, None], ({f"{self.channels()[0]}/score": score} if probes else {})
+        name = f"{self.channels()[0]}/score"
+        return [(part[:, None], {name: part} if probes else {})
+                for part in np.split(score, np.cumsum([len(x) for x in features])[:-1])]
 
     def snapshot(self) -> str:
         """What a run continues from: the fit alone (the model is frozen, and a step's
