@@ -10,6 +10,11 @@ model for the flight, and stepping :meth:`~alfa_bench.methods.Detector.update`, 
 call per grid step (what the streaming contract alone would do). Both give the same
 scores (checked). Prints a Markdown table of the best of ``--repeat``: time per flight,
 per row, and their ratio.
+
+A second table scores ``--continuations`` flights continued from one fork at half the
+flight (as the injected grid's flights of one source are): one
+:meth:`~alfa_bench.methods.Detector.run` each, against one
+:meth:`~alfa_bench.methods.Detector.run_many` for them all (the same scores, checked).
 """
 
 from __future__ import annotations
@@ -23,7 +28,7 @@ import numpy as np
 
 from alfa_bench.data import load_flight, sample
 from alfa_bench.data.synthetic import write_corpus
-from alfa_bench.methods import Detector, training_segments
+from alfa_bench.methods import Detector, forks, training_segments
 from alfa_bench.methods.outliers import PyODDetector
 
 
@@ -40,10 +45,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--models", default="IForest,ECOD,HBOS,PCA,KNN")
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--continuations", type=int, default=100)
     args = parser.parse_args()
     processed = Path(tempfile.mkdtemp(prefix="bench-outliers-")) / "processed"
     write_corpus(processed)
     flights = [load_flight(p) for p in sorted(processed.iterdir())]
+    fitted = []
     print("| model | rows | batch, ms a flight | per step, ms a flight | per step / batch |")
     print("|---|---|---|---|---|")
     for model in args.models.split(","):
@@ -55,6 +62,19 @@ def main() -> None:
         np.testing.assert_allclose(score, ref, rtol=1e-9, atol=1e-9)
         print(f"| {model} | {s.t.size} | {1e3 * batch:.1f} | {1e3 * stepped:.1f} | "
               f"{stepped / batch:.0f}x |")
+        fitted.append((model, d, s))
+    print("\n| model | flights continued | one call each, ms | one call for all, ms | ratio |")
+    print("|---|---|---|---|---|")
+    for model, d, s in fitted:
+        fork = next(iter(forks(d, flights[0], [s.t[s.t.size // 2]]).values()))
+        items = [(s, fork.sampled.t.size, fork.state)] * args.continuations
+        each, scores = best(lambda d=d, items=items: [d.run(x, False, k, state)
+                                                      for x, k, state in items], args.repeat)
+        together, many = best(lambda d=d, items=items: d.run_many(items), args.repeat)
+        for (a, _), (b, _) in zip(scores, many, strict=True):
+            np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9)
+        print(f"| {model} | {args.continuations} | {1e3 * each:.1f} | {1e3 * together:.1f} | "
+              f"{each / together:.1f}x |")
 
 
 if __name__ == "__main__":
