@@ -204,10 +204,10 @@ class _FoldRunner:
             self.forks[source] = self.guarded("detect", source, lambda: forks(
                 self.detector, self.flights[source], onsets)) or {}
             # the fold's flights injected into this source, scored in one call
-            self.continued = continue_forks(self.detector, [
-                self.flights[n] for n in self.scored
-                if self.sources.get(n, ("",))[0] == source and n not in self.failed],
-                self.forks[source])
+            injected = [n for n in self.scored if self.sources.get(n, ("",))[0] == source]
+            built = [self.guarded("detect", n, lambda n=n: self.flights[n]) for n in injected]
+            self.continued = continue_forks(self.detector, [f for f in built if f is not None],
+                                            self.forks[source])
         return self.guarded("detect", name, lambda: detection_record(
             self.method, self.spec, self.detector, self.flights[name], self.sha, info,
             forked=self.forks[source], continued=self.continued.pop(name, None)))

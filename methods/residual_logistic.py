@@ -201,6 +201,8 @@ class _ResidualClassifier:
     def fit_model(self, segments: list[Labelled]) -> _ResidualClassifier:
         """Fit (1) on the nominal steps and the logistic regression on the steps after
         the warm-up, positives as ``positives`` says; return self."""
+        if self.positives not in ("no_emr", "all"):
+            raise ValueError(f"positives must be 'no_emr' or 'all', got {self.positives!r}")
         warm = self._steps(self.warmup_s)
         nominal, rows, labels = [], [], []
         for seg in segments:
@@ -348,8 +350,6 @@ class ResidualLogistic(_ResidualClassifier, MaximaThresholds, Detector):
     def fit(self, segments: list[Labelled]) -> ResidualLogistic:
         """Per-flight maxima, each by the model fitted without the flight's date; then
         the model on every segment, and the thresholds."""
-        if self.positives not in ("no_emr", "all"):
-            raise ValueError(f"positives must be 'no_emr' or 'all', got {self.positives!r}")
         dates = [parse_flight_name(seg.flight)["date"] for seg in segments]
         if len(set(dates)) < 2:
             raise CalibrationError("residual logistic: the out-of-sample maxima need "

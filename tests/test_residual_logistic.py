@@ -111,8 +111,9 @@ def test_emergency_trajectory_faults_are_positives_only_when_asked():
     ResidualLogistic(positives="all").fit_model(emr_only)
     with pytest.raises(CalibrationError, match="no faulty steps"):
         ResidualLogistic(positives="no_emr").fit_model(emr_only)
-    with pytest.raises(ValueError, match="positives"):
-        ResidualLogistic(positives="some").fit(_corpus())
+    for cls in (ResidualLogistic, ResidualLogisticPublished):
+        with pytest.raises(ValueError, match="positives"):
+            cls(positives="some").fit(_corpus())
 
 
 def test_each_maximum_comes_from_a_model_that_never_saw_its_date(monkeypatch):
