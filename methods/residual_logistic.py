@@ -72,6 +72,7 @@ as detection only.
 
 from __future__ import annotations
 
+import contextlib
 import math
 from collections import deque
 
@@ -80,7 +81,7 @@ from numpy.lib.stride_tricks import sliding_window_view
 
 from alfa_bench.data import Sampled, parse_flight_name
 
-from .base import CalibrationError, Detector, Labelled, StaleStateError, fit_token
+from .base import CalibrationError, Detector, Labelled, StaleStateError, fit_token, json_ready
 from .extremes import MaximaThresholds
 from .windows import window_steps
 
@@ -374,6 +375,10 @@ class ResidualLogisticPublished(_ResidualClassifier, Detector):
         The threshold of best training accuracy (:func:`best_accuracy_threshold`).
     training_accuracy_ : float
         That accuracy, on the training flights scored in sample.
+    flight_maxima_ : dict
+        Per training flight, its largest score before onset and from onset on, and
+        whether it is faulty: what the threshold was chosen on, and what
+        :meth:`pool_thresholds` draws from.
     """
 
     def __init__(self, positives="all", C=0.1, persist=5, warmup_s=15.0, rate_hz=10.0):
@@ -386,15 +391,14 @@ class ResidualLogisticPublished(_ResidualClassifier, Detector):
     def fit(self, segments: list[Labelled]) -> ResidualLogisticPublished:
         """The model, then the threshold of best accuracy on its training flights."""
         self.fit_model(segments)
-        before, after, faulty = [], [], []
+        self.flight_maxima_ = {}
         for seg in segments:
             score = self.run(seg.sampled)[0][:, 0]
             fault = (np.zeros(seg.t.size, bool) if seg.onset_s is None
                      else seg.t >= seg.onset_s)
-            before.append(_largest(score[~fault]))
-            after.append(_largest(score[fault]))
-            faulty.append(seg.onset_s is not None)
-        before, after, faulty = map(np.array, (before, after, faulty))
+            self.flight_maxima_[seg.flight] = (_largest(score[~fault]), _largest(score[fault]),
+                                               seg.onset_s is not None)
+        before, after, faulty = map(np.array, zip(*self.flight_maxima_.values(), strict=True))
         self.threshold_ = best_accuracy_threshold(before, after, faulty)
         fp = before > self.threshold_
         right = ~fp & np.where(faulty, after > self.threshold_, True)
@@ -405,10 +409,24 @@ class ResidualLogisticPublished(_ResidualClassifier, Detector):
         self._check_fitted("threshold_")
         return np.array([self.threshold_])
 
+    def pool_thresholds(self, pools: list[dict[str, int]]) -> np.ndarray:
+        """Per pool (flight -> times drawn), the threshold of best accuracy on the
+        training flights drawn, each counted as often as it is drawn, the model kept;
+        NaN where the pool's flights give no finite score. Shape (pools, 1)."""
+        self._check_fitted("threshold_")
+        out = np.full((len(pools), 1), np.nan)
+        for i, pool in enumerate(pools):
+            drawn = [m for f, m in self.flight_maxima_.items() for _ in range(pool.get(f, 0))]
+            if drawn:
+                with contextlib.suppress(CalibrationError):
+                    out[i, 0] = best_accuracy_threshold(
+                        *map(np.array, zip(*drawn, strict=True)))
+        return out
+
     def fitted(self) -> dict:
         self._check_fitted("threshold_")
         return {"threshold": self.threshold_, "training_accuracy": self.training_accuracy_,
-                "model": self._model_report()}
+                "flight_maxima": json_ready(self.flight_maxima_), "model": self._model_report()}
 
 
 def _largest(score: np.ndarray) -> float:

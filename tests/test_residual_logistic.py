@@ -146,3 +146,18 @@ def test_a_single_date_cannot_calibrate():
     one_date = [f for f in _corpus() if "2018-07-18" in f.flight]
     with pytest.raises(CalibrationError, match="two dates"):
         ResidualLogistic().fit(one_date)
+
+
+def test_the_published_rule_is_chosen_again_on_each_pool_of_its_training_flights():
+    d = ResidualLogisticPublished().fit(_corpus())
+    flights = [f.flight for f in _corpus()]
+    every = {f: 1 for f in flights}
+    doubled = {f: 2 for f in flights}
+    fault_free_only = {f: 1 for f in flights if "no_failure" in f}
+    got = d.pool_thresholds([every, doubled, {}, fault_free_only])
+    # the whole pool, once or twice over, gives the fit's own threshold; no flight, none
+    assert got[0, 0] == got[1, 0] == d.thresholds()[0] and np.isnan(got[2, 0])
+    # fault-free flights alone: every one quiet from their largest score on, the last
+    # candidate, so half a unit above it
+    before = [d.flight_maxima_[f][0] for f in fault_free_only]
+    assert got[3, 0] == max(before) + 0.5
