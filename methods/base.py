@@ -658,6 +658,8 @@ def continue_forks(detector: Detector, flights: list[Flight], forked: dict[float
     scored from its fork, all in one :meth:`Detector.run_many` call: flight -> (its
     samples, its scores, no probes). A flight that cannot be sampled or shares no
     fork is left out, for :func:`run_detector` to run (or fail) on its own."""
+    if not forked:                        # a detector that cannot fork: nothing to batch
+        return {}
     todo = []
     for flight in flights:
         fork = fork_for(forked, flight.fault.onset_s if flight.fault else None)
