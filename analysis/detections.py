@@ -45,7 +45,14 @@ from alfa_bench.methods import (
     run_detector,
 )
 
-from .held_out import TooFewGroupsError, check_held_out, folds, group_labels, groups_of
+from .held_out import (
+    TooFewGroupsError,
+    check_held_out,
+    folds,
+    group_labels,
+    groups_of,
+    own_calibration,
+)
 from .isolation import isolate
 from .provenance import provenance
 from .scoring import flight_outcome
@@ -87,7 +94,7 @@ def detect_all(method: str, spec: dict, flights: Mapping[str, Flight], manifest:
     """
     if detector is None:
         detector = make_detector(spec["detector"], spec.get("params"))
-    calibration = {**calibration, **spec.get("calibration", {})}
+    calibration = own_calibration(calibration, spec)
     train = manifest if calibrate_on is None else calibrate_on
     sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
     sha |= dict(zip(train["flight"], train["sha256"], strict=True))

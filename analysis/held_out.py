@@ -17,10 +17,16 @@ import pandas as pd
 from alfa_bench.methods import CalibrationError
 
 __all__ = ["GROUPINGS", "HeldOutError", "TooFewGroupsError", "check_held_out", "folds",
-           "group_labels", "groups_of"]
+           "group_labels", "groups_of", "own_calibration"]
 
 #: the manifest columns whose values, joined by "-", name a flight's group
 GROUPINGS = {"date": ("date",), "recording": ("date", "time"), "flight": ("flight",)}
+
+
+def own_calibration(calibration: dict, spec: dict) -> dict:
+    """The calibration settings of the run ``spec``: ``calibration``, with the run's own
+    (``calibration: {group_by: ...}`` on the run) in their place."""
+    return {**calibration, **spec.get("calibration", {})}
 
 
 def group_labels(manifest: pd.DataFrame, group_by: str) -> pd.Series:

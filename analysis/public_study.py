@@ -17,6 +17,8 @@ import pandas as pd
 from alfa_bench.data import subset_flights
 from alfa_bench.render import fmt, markdown
 
+from .scoring import flight_outcome
+
 __all__ = ["STUDY_FLIGHTS", "STUDY_NAME", "STUDY_SUMMARY", "against_study",
            "against_study_markdown", "protocol_steps", "protocol_steps_markdown",
            "study_counts", "study_outcome"]
@@ -84,10 +86,11 @@ def _missing(v) -> bool:
 def study_outcome(onset_s: float | None, first_alarm_s: float | None) -> str:
     """A flight's one outcome by the paper's rule, as the study counts it: ``FP`` for an
     alarm before onset or on a fault-free flight, ``TP`` for a later one however late,
-    ``FN`` or ``TN`` for none."""
-    if _missing(first_alarm_s):
-        return "TN" if _missing(onset_s) else "FN"
-    return "FP" if _missing(onset_s) or first_alarm_s < onset_s else "TP"
+    ``FN`` or ``TN`` for none (:func:`~.scoring.flight_outcome` without a deadline, an
+    early alarm on a faulty flight counted once, as ``FP``). NaN is as None."""
+    outcome = flight_outcome(None if _missing(onset_s) else onset_s,
+                             None if _missing(first_alarm_s) else first_alarm_s)
+    return "FP" if outcome == "FP+FN" else outcome
 
 
 def study_counts(outcomes) -> dict[str, int]:

@@ -197,9 +197,9 @@ def refit_first_alarms(spec: dict, flights, manifest: pd.DataFrame, calibration:
         training_segments,
     )
 
-    from .held_out import check_held_out, folds, group_labels
+    from .held_out import check_held_out, folds, group_labels, own_calibration
 
-    calibration = {**calibration, **spec.get("calibration", {})}
+    calibration = own_calibration(calibration, spec)
     group = dict(zip(manifest["flight"], group_labels(manifest, calibration["group_by"]),
                      strict=True))
     out: dict[str, list[float | None]] = {}

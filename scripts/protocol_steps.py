@@ -2,18 +2,16 @@
 
 from pathlib import Path
 
-import pandas as pd
-
 from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.analysis.public_study import protocol_steps, protocol_steps_markdown
 from alfa_bench.data import read_manifest
-from alfa_bench.outputs.provenance import stamp
+from alfa_bench.outputs.provenance import read_table, stamp
 from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 manifest = read_manifest(sm.input.manifest)
-table = protocol_steps(pd.read_csv(sm.input.per_flight), manifest, list(sm.params.steps),
+table = protocol_steps(read_table(sm.input.per_flight), manifest, list(sm.params.steps),
                        sm.params.primary, float(sm.params.stable))
 table.to_csv(sm.output.csv, index=False)
 Path(sm.output.md).write_text(protocol_steps_markdown(table, sm.params.primary,
