@@ -55,3 +55,4 @@ rule all:
 
 
 include: "rules/provenance.smk"
+include: "rules/stale.smk"

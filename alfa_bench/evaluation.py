@@ -335,13 +335,16 @@ def _setting(config: dict, name: str):
 def compare(*results: Result, published: str | os.PathLike | None = None) -> pd.DataFrame:
     """The comparison table (``comparison.csv``'s columns) of ``results``, ranked beside
     the runs of a workflow's results folder ``published`` (the ``results/`` of a
-    ``snakemake all``), or among themselves with ``published`` None.
+    ``snakemake all``, or the checkout holding it), or among themselves with
+    ``published`` None. Only the runs of the published run's config are read: a result
+    folder left by a run since taken out of it is not ranked.
 
     Only like is compared with like: every result must be scored with the published
     run's settings (:data:`SCORING_SETTINGS`: deadline, subsets, grouping, margin,
     pools and stable share), on its corpus (the same flights, the same files), by the
     same alfa-bench version; otherwise a :class:`ValueError` names the setting that
-    differs. A run that did not score one of the published flights is not ranked.
+    differs. Every run is ranked on the flights every run scored; one that failed on
+    flights the others scored is flagged (``failed_flights``).
 
     Raises
     ------
@@ -375,7 +378,9 @@ def compare(*results: Result, published: str | os.PathLike | None = None) -> pd.
             _check_like(run["config"], float(run["config"]["scoring"]["deadline_s"]),
                         _subsets(run["config"]), manifest, res, str(out), res.method,
                         run["code"]["version"])
-        folders = sorted(p for p in (out / "detections").iterdir() if p.is_dir())
+        # the runs of the published config: a folder left by a run taken out since is stale
+        folders = [out / "detections" / m for m in run["config"]["methods"]
+                   if (out / "detections" / m).is_dir()]
         clash = sorted({p.name for p in folders} & set(names))
         if clash:
             raise ValueError(f"{clash} already named in {out}: evaluate(..., name=...) "
@@ -390,8 +395,11 @@ def compare(*results: Result, published: str | os.PathLike | None = None) -> pd.
 
 
 def _published(published: str | os.PathLike) -> Path:
-    """The results folder ``published``, checked to hold a workflow's results."""
+    """The results folder ``published`` (or the ``results/`` of the checkout it names),
+    checked to hold a workflow's results."""
     out = Path(published)
+    if not (out / "flights.csv").exists() and (out / "results/flights.csv").exists():
+        out = out / "results"
     missing = [n for n in ("flights.csv", "load_failures.csv", "provenance.json",
                            "detections") if not (out / n).exists()]
     if missing:

@@ -269,18 +269,26 @@ def leaking_flights(table: pd.DataFrame, manifest: pd.DataFrame, flights: list[s
     return out
 
 
-def audit_note(table: pd.DataFrame, manifest: pd.DataFrame, subset: str) -> str:
+def audit_note(table: pd.DataFrame, manifest: pd.DataFrame, subset: str,
+               refused: pd.DataFrame | None = None) -> str:
     """One paragraph: whether the audit finds a sensor or setpoint carrying the label on
-    a flight of ``subset`` (:func:`leaking_flights`), the headline's condition."""
+    a flight of ``subset`` (:func:`leaking_flights`), the headline's condition.
+    ``refused``: the flights refused at load (``failures.csv`` rows, with ``subsets``),
+    counted in the subset's size but not audited."""
     flights = subset_flights(manifest, subset)
     bad = leaking_flights(table, manifest, flights)
+    gone = 0 if refused is None else int(refused["subsets"].fillna("").astype(str)
+                                         .str.split(";").apply(lambda s: subset in s).sum())
+    size = (f"{len(flights)} flights" if not gone else
+            f"{len(flights) + gone} flights, {gone} refused at load and not audited")
     if not bad:
-        return (f"The headline subset `{subset}` ({len(flights)} flights): the leakage audit "
+        return (f"The headline subset `{subset}` ({size}): the leakage audit "
                 "(`results/tables/leakage.md`) finds no sensor or setpoint carrying the label "
                 "on any of its flights.\n\n")
     signals = sorted({s for names in bad.values() for s in names})
     return (f"**WARNING: the headline subset `{subset}` is not clean.** On {len(bad)} of its "
-            f"{len(flights)} flights (e.g. `{next(iter(bad))}`) the leakage audit finds "
+            f"{len(flights)} audited flights ({size}; e.g. `{next(iter(bad))}`) the leakage "
+            "audit finds "
             f"{', '.join(f'`{s}`' for s in signals)} carrying the label: set "
             "`primary_subset` to a subset without them.\n\n")
 

@@ -33,7 +33,7 @@ import pandas as pd
 from .cache import cache_path, write_cached
 from .errors import FAILURE_COLUMNS, AlfaDataError, failure_row
 from .flight import Flight, entries, find_flights, load_flight, not_a_flight, parse_flight_name
-from .signals import check_physical, not_measured
+from .signals import check_signals, not_measured
 
 __all__ = ["ICRA22_LAST_DATE", "SUBSETS", "build_manifest", "flight_sha256", "manifest_of",
            "manifest_row", "name_subsets", "read_manifest", "scan_flights", "subset_flights",
@@ -123,7 +123,7 @@ def name_subsets(flight: str) -> str:
 
 def _row(path: Path, cache: Path | None) -> dict:
     flight = load_flight(path)
-    check_physical(flight)
+    check_signals(flight)
     row = manifest_row(flight)
     if cache is not None:
         write_cached(flight, cache_path(cache, flight.id), row["sha256"])

@@ -43,6 +43,13 @@ Bad values and gaps that parse (also in docs/bad-data.md):
   :data:`COVERAGE_S` of its first row and end within it of its last (in ALFA every
   topic does within 1.1 s); one that starts late or stops early would silently
   shorten the span scored, so it is an :class:`AlfaDataError` naming the topic.
+
+A flight is read one way by every run: :func:`check_signals` refuses, at load, a
+flight on which any catalogue signal could not be read (a missing topic, a bad cell,
+a gap, a topic that does not cover the flight, a value out of bounds), whether or not
+a configured run reads it. Left to the runs, such a flight would be scored by some
+and not by others, and no two runs would be compared on the same flights. Every
+ALFA flight passes.
 """
 
 from __future__ import annotations
@@ -55,7 +62,7 @@ from .errors import AlfaDataError, UnknownSignalError
 from .flight import Flight
 
 __all__ = ["COVERAGE_S", "KINDS", "MAX_HOLD_S", "SIGNALS", "Sampled", "Signal", "check_physical",
-           "not_measured", "reads_actuators", "sample", "series"]
+           "check_signals", "not_measured", "reads_actuators", "sample", "series"]
 
 #: The longest a row's value may be held on the sampling grid, s.
 MAX_HOLD_S = 1.0
@@ -242,38 +249,40 @@ def not_measured(flight: Flight, names=None) -> tuple[str, ...]:
     """The sensors among ``names`` (default: every catalogue signal whose topic the
     flight has) that are constant over the whole flight: not measured on it. A
     constant setpoint is a command that did not change, and a constant actuator an
-    output not used; neither is missing data.
-
-    With ``names`` None, a column that cannot be read is passed over: it is an error
-    only for a method that reads it (:func:`sample` raises it then)."""
-    survey = names is None
-    if survey:
+    output not used; neither is missing data."""
+    if names is None:
         names = [n for n, sig in SIGNALS.items() if sig.topic in flight.topics]
     dead = []
     for name in (n for n in names if SIGNALS[n].kind == "sensor"):
-        try:
-            value = series(flight, name)[1]
-        except AlfaDataError:
-            if survey:
-                continue
-            raise
+        value = series(flight, name)[1]
         if value.size and np.all(value == value[0]):
             dead.append(name)
     return tuple(dead)
 
 
+def check_signals(flight: Flight) -> None:
+    """Raise :class:`AlfaDataError` where any catalogue signal of ``flight`` could not
+    be read the way :func:`sample` reads it: a missing topic, a topic that does not
+    cover the flight, a gap of more than :data:`MAX_HOLD_S` between rows, a cell that
+    is not a finite number, a value outside the signal's bounds (:func:`check_physical`).
+    Called at load, so that a flight is refused for every run or read by all alike."""
+    for tp in dict.fromkeys(flight.topic(sig.topic) for sig in SIGNALS.values()):
+        _check_coverage(flight, tp)
+        _check_gaps(flight, tp)
+    for name in SIGNALS:
+        series(flight, name)
+    check_physical(flight)
+
+
 def check_physical(flight: Flight) -> None:
     """Raise :class:`AlfaDataError` at the first value of a catalogue signal's column
-    outside its :attr:`Signal.bounds` (module docstring). A column that cannot be read
-    is passed over: it is an error only for a method that reads it."""
+    outside its :attr:`Signal.bounds` (module docstring); a topic the flight lacks is
+    passed over (:func:`check_signals` refuses it)."""
     for name, sig in SIGNALS.items():
         if sig.bounds is None or sig.topic not in flight.topics:
             continue
         tp = flight.topics[sig.topic]
-        try:
-            value = tp.values(sig.column)
-        except AlfaDataError:
-            continue
+        value = tp.values(sig.column)
         lo, hi = sig.bounds
         out = (value < lo) | (value > hi)
         if out.any():
@@ -295,6 +304,20 @@ def _check_coverage(flight: Flight, tp) -> None:
                             column="%time", line=int(tp.lines[0 if late > COVERAGE_S else -1]))
 
 
+def _check_gaps(flight: Flight, tp, max_hold_s: float = MAX_HOLD_S) -> None:
+    """Refuse a topic with more than ``max_hold_s`` between two rows: on a grid a value
+    would be held that long."""
+    step = np.diff(tp.t)
+    if step.size and step.max() > max_hold_s:
+        i = int(np.argmax(step > max_hold_s))
+        median = float(np.median(step))
+        raise AlfaDataError(
+            f"no row for {step[i]:.2f} s (from {tp.t[i]:.2f} s to {tp.t[i + 1]:.2f} s on the "
+            f"flight clock; the topic's median period is {median:.2f} s): a value would be "
+            f"held longer than {max_hold_s} s", flight=flight.id, file=tp.file,
+            column="%time", line=int(tp.lines[i + 1]))
+
+
 def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float,
            max_hold_s: float = MAX_HOLD_S) -> Sampled:
     """Sample the named signals of ``flight`` at ``rate_hz`` (causal hold)."""
@@ -313,7 +336,7 @@ def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float,
         raise AlfaDataError(f"signals {list(names)} never overlap in time", flight=flight.id)
 
     for tp in dict.fromkeys(topics):
-        _check_hold(flight, tp, t, max_hold_s)
+        _check_gaps(flight, tp, max_hold_s)
     x = np.empty((t.size, len(names)))
     fresh = np.empty((t.size, len(names)), dtype=bool)
     for j, (name, tp) in enumerate(zip(names, topics, strict=True)):
@@ -325,18 +348,3 @@ def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float,
         source = last_change[row]
         fresh[:, j] = np.r_[True, source[1:] != source[:-1]]
     return Sampled(t=t, x=x, fresh=fresh, names=names, flight=flight.id)
-
-
-def _check_hold(flight: Flight, tp, t: np.ndarray, max_hold_s: float) -> None:
-    """Refuse a grid ``t`` on which a row of ``tp`` would be held over ``max_hold_s``."""
-    row = np.searchsorted(tp.t, t, side="right") - 1
-    age = t - tp.t[row]
-    if age.max() <= max_hold_s:
-        return
-    i = int(row[np.argmax(age > max_hold_s)])
-    median = float(np.median(np.diff(tp.t))) if tp.t.size > 1 else float("nan")
-    raise AlfaDataError(
-        f"no row for {tp.t[i + 1] - tp.t[i]:.2f} s (from {tp.t[i]:.2f} s to {tp.t[i + 1]:.2f} s "
-        f"on the flight clock; the topic's median period is {median:.2f} s): a value would "
-        f"be held longer than {max_hold_s} s", flight=flight.id, file=tp.file, column="%time",
-        line=int(tp.lines[i + 1]))

@@ -152,6 +152,10 @@ def write_flight(processed: Path, name: str, *, duration_s: float = 80.0, rate_h
         measured = np.where(faulty, y_fault, y)
         write_csv(folder / f"{name}-mavros-nav_info-{axis}.csv", ATTITUDE_HEADER,
                   attitude_rows(t_ns + i * 3_000_000, u, measured))
+    heading = np.random.default_rng(seed + 6000)
+    yaw_cmd = 90.0 + np.cumsum(heading.normal(0, 0.5, n))
+    write_csv(folder / f"{name}-mavros-nav_info-yaw.csv", ATTITUDE_HEADER,
+              attitude_rows(t_ns + 7_000_000, yaw_cmd, yaw_cmd + heading.normal(0, 1.0, n)))
     rate_topics(folder, name, duration_s, onset_s, rng, (fault_topic, code), emulate_surfaces,
                 seed)
     if onset_s is not None:

@@ -298,6 +298,12 @@ class Detector(ABC):
         """Hyper-parameters by name, as passed to ``__init__``."""
         return {n: getattr(self, n) for n in self.param_names()}
 
+    def check_params(self) -> None:  # noqa: B027 (a hook: most detectors name nothing)
+        """Resolve what the hyper-parameters name outside the package (a library's model
+        by its name), raising :class:`ValueError` where one does not resolve, saying what
+        to do. The workflow's dry run calls it for every configured run, so that a run
+        fails there, not in its job. Nothing to resolve by default."""
+
     @abstractmethod
     def signals(self) -> tuple[str, ...]:
         """Names (see :data:`alfa_bench.data.SIGNALS`) of the input columns."""
@@ -350,8 +356,11 @@ class Detector(ABC):
         :math:`c` alarms when :math:`s_c(k) > \\gamma_c`. By default the
         ``threshold`` hyper-parameter, for every channel."""
         if "threshold" not in self.param_names():
-            raise NotImplementedError(f"{type(self).__name__} has no threshold "
-                                      "hyper-parameter: define thresholds()")
+            raise NotImplementedError(
+                f"{type(self).__name__} has no `threshold` hyper-parameter and no "
+                "thresholds() of its own, so its channels cannot alarm: add a `threshold` "
+                "argument to __init__ (stored as self.threshold), or define thresholds() "
+                "returning one positive threshold per channel")
         return np.full(len(self.channels()), float(self.threshold))
 
     def probes(self) -> dict[str, float]:
@@ -417,7 +426,10 @@ class Detector(ABC):
         kept = np.full((n, len(names)), np.nan)
         for k in range(n):
             try:
-                score[k] = self.update(s.x[start + k], s.fresh[start + k])
+                out = self.update(s.x[start + k], s.fresh[start + k])
+                if out is None:     # numpy would store it as NaN: a score never computed
+                    raise ValueError("update() returned None")
+                score[k] = out
             except ValueError as e:
                 raise self._wrong_scores(s.x[start + k], s.fresh[start + k]) or e from e
             if names:
@@ -435,8 +447,14 @@ class Detector(ABC):
     def _wrong_scores(self, x: np.ndarray, fresh: np.ndarray) -> ValueError | None:
         """Where :meth:`update` returns other than one score per channel, the error that
         says so (the step is taken again on a copy); None where it does not."""
-        out = np.asarray(copy.deepcopy(self).update(x, fresh))
+        raw = copy.deepcopy(self).update(x, fresh)
         channels = self.channels()
+        if raw is None:
+            return ValueError(f"{type(self).__name__}.update() returned None for "
+                              f"{len(channels)} channel(s) {list(channels)}: return one "
+                              "score per channel, an array of that length (NaN where a "
+                              "score is not computed yet)")
+        out = np.asarray(raw)
         if out.shape == (len(channels),):
             return None
         return ValueError(f"{type(self).__name__}.update() returned {out.size} value(s) of "

@@ -36,6 +36,7 @@ A plugin's own tests run them all with one decorator::
 from __future__ import annotations
 
 import copy
+import functools
 import inspect
 import json
 import logging
@@ -46,7 +47,7 @@ from pathlib import Path
 
 import numpy as np
 
-from alfa_bench.data import SIGNALS, load_flight, sample
+from alfa_bench.data import SIGNALS, UnknownSignalError, load_flight, sample
 from alfa_bench.data.synthetic import rename_flight, write_corpus
 
 from .base import (
@@ -111,84 +112,164 @@ def _skip(reason: str):
     pytest.skip(reason)
 
 
-def _assert_same(a, b, upto=None):
+def _assert_same(a, b, upto=None, what: str = "the two runs"):
     sl = slice(None) if upto is None else slice(0, upto)
-    np.testing.assert_array_equal(a.t[sl], b.t[sl])
-    np.testing.assert_array_equal(a.score[sl], b.score[sl])  # NaN == NaN here
-    np.testing.assert_array_equal(a.alarm[sl], b.alarm[sl])
+    for name in ("t", "score", "alarm"):
+        # NaN == NaN here
+        np.testing.assert_array_equal(getattr(a, name)[sl], getattr(b, name)[sl],
+                                      err_msg=f"{what}: {name} differs")
 
 
+def _expect(ok, expected: str, got) -> None:
+    """Fail the check unless ``ok``, saying what was expected and what came back."""
+    if not ok:
+        raise AssertionError(f"expected {expected}; got {got}")
+
+
+def _check(todo: str):
+    """A contract check whose failure says which check it is, what it expected, what came
+    back, and ``todo``: what to do about it (never an empty message)."""
+    def wrap(check):
+        name = check.__name__.removeprefix("check_")
+
+        @functools.wraps(check)
+        def checked(detector: Detector) -> None:
+            try:
+                check(detector)
+            except AssertionError as e:
+                said = str(e).strip() or "a condition failed without a message"
+                raise AssertionError(f"contract check {name}: {said}\nWhat to do: {todo}"
+                                     ) from e
+        return checked
+    return wrap
+
+
+def check_signals_are_in_the_catalogue(detector: Detector) -> None:
+    """Every signal :meth:`~.base.Detector.signals` names is in the catalogue: else
+    :class:`~alfa_bench.data.UnknownSignalError`, listing the catalogue."""
+    unknown = [n for n in detector.signals() if n not in SIGNALS]
+    if unknown:
+        raise UnknownSignalError(
+            f"{type(detector).__name__}.signals() names {unknown}, which the catalogue "
+            f"does not hold; known: {sorted(SIGNALS)} (docs/python.md lists each one)")
+
+
+@_check("store each __init__ argument as an attribute of the same name and nothing "
+        "else; set learned state in fit() (or reset() for running state), in attributes "
+        "ending in _")
 def check_constructor_stores_hyper_parameters_only(detector: Detector) -> None:
     d = copy.deepcopy(detector)
-    assert set(vars(d)) == set(d.get_params())
+    _expect(set(vars(d)) == set(d.get_params()),
+            f"__init__ to store its parameters {sorted(d.get_params())} and nothing else",
+            f"attributes {sorted(vars(d))}")
     before = set(vars(d))
     _fit(d).reset()
     learned = set(vars(d)) - before
-    assert all(a.endswith("_") for a in learned), sorted(learned)
-    assert learned or not d.calibrated, "a calibrated detector learned nothing"
+    _expect(all(a.endswith("_") for a in learned),
+            "every attribute fit() or reset() sets to end in _",
+            sorted(a for a in learned if not a.endswith("_")))
+    _expect(learned or not d.calibrated, "a calibrated detector to learn in fit()",
+            "no learned attribute")
 
 
+@_check("give run() the base class's signature: run(self, s, probes=False, start=0, "
+        "state=None)")
 def check_run_takes_the_base_arguments(detector: Detector) -> None:
     """A ``run()`` override takes ``(s, probes, start, state)``, as the workflow calls
     it (a snapshot of None means it is never given a state)."""
     names = list(inspect.signature(type(detector).run).parameters)
-    assert names[:5] == ["self", "s", "probes", "start", "state"], names
+    _expect(names[:5] == ["self", "s", "probes", "start", "state"],
+            "run(self, s, probes, start, state)", f"run({', '.join(names)})")
 
 
+@_check("an uncalibrated detector learns nothing (fitted() is {}); a calibrated one "
+        "raises NotFittedError, naming fit(), when run before fit()")
 def check_calibrated_detectors_refuse_to_run_unfitted(detector: Detector) -> None:
     d = copy.deepcopy(detector)
     if not d.calibrated:
-        assert d.fitted() == {}
+        _expect(d.fitted() == {}, "fitted() == {} for an uncalibrated detector", d.fitted())
         return
     try:
         run_detector(d, _flight())
     except NotFittedError as e:
-        assert "fit" in str(e)
+        _expect("fit" in str(e), "a NotFittedError that names fit()", repr(str(e)))
     else:
-        raise AssertionError("a calibrated detector ran before fit()")
+        raise AssertionError("expected NotFittedError from a calibrated detector run "
+                             "before fit(); got a run")
 
 
+@_check("return plain numbers, strings, lists and dicts from fitted(): no arrays, no "
+        "NaN or infinity (convert with .tolist(), float())")
 def check_fitted_values_are_json_ready(detector: Detector) -> None:
-    json.dumps(_fitted(detector).fitted(), allow_nan=False)
+    fitted = _fitted(detector).fitted()
+    try:
+        json.dumps(fitted, allow_nan=False)
+    except (TypeError, ValueError) as e:
+        raise AssertionError(f"expected fitted() to be JSON-ready; got {e}") from e
 
 
+@_check("return from update() one score per channel of channels(), an array of that "
+        "length; a run() of its own returns an array (steps, channels)")
 def check_outputs_have_the_declared_shape(detector: Detector) -> None:
     d = _fitted(detector)
-    trace = run_detector(d, _flight())
-    assert trace.score.shape == trace.alarm.shape == (trace.t.size, len(d.channels()))
-    assert trace.alarm.dtype == bool
-    assert np.all(np.diff(trace.t) > 0)
+    s = sample(_flight(), d.signals(), d.rate_hz)
+    score, _ = d.run(s)       # before the thresholds, which the next check judges
+    want = (s.t.size, len(d.channels()))
+    _expect(np.shape(score) == want, f"scores of shape {want} (steps, channels "
+            f"{list(d.channels())})", f"shape {np.shape(score)}")
 
 
+@_check(f"set the class attribute family to one of {list(FAMILIES)}")
 def check_its_family_is_one_the_tables_name(detector: Detector) -> None:
-    assert detector.family in FAMILIES, detector.family
+    _expect(detector.family in FAMILIES, f"a family among {list(FAMILIES)}",
+            repr(detector.family))
 
 
+@_check("return from channel_outputs() one signal per channel, each among signals() "
+        "and the catalogue (alfa_bench.data.SIGNALS)")
 def check_each_channel_names_the_measured_signal_it_scores(detector: Detector) -> None:
-    outputs = detector.channel_outputs()
-    assert len(outputs) == len(detector.channels())
-    assert set(outputs) <= set(detector.signals()) and set(outputs) <= set(SIGNALS)
+    outputs, channels = detector.channel_outputs(), detector.channels()
+    _expect(len(outputs) == len(channels), f"one output per channel of {list(channels)}",
+            list(outputs))
+    _expect(set(outputs) <= set(detector.signals()) and set(outputs) <= set(SIGNALS),
+            f"outputs among signals() {list(detector.signals())}",
+            sorted(set(outputs) - set(detector.signals())) or sorted(set(outputs) - set(SIGNALS)))
 
 
+@_check("return from thresholds() one finite, positive threshold per channel, and "
+        "leave alarms() to the base class (a channel alarms when its score is above it)")
 def check_each_channel_has_one_positive_threshold(detector: Detector) -> None:
     d = _fitted(detector)
     trace = run_detector(d, _flight())
-    assert trace.threshold.shape == (len(d.channels()),)
-    assert np.all(np.isfinite(trace.threshold) & (trace.threshold > 0)), trace.threshold
-    np.testing.assert_array_equal(trace.alarm, d.alarms(trace.score))
+    want = (len(d.channels()),)
+    _expect(trace.threshold.shape == want, f"thresholds of shape {want}",
+            f"shape {trace.threshold.shape}")
+    _expect(np.all(np.isfinite(trace.threshold) & (trace.threshold > 0)),
+            "finite, positive thresholds", trace.threshold)
+    _expect(trace.alarm.dtype == bool, "alarms() to return booleans", trace.alarm.dtype)
+    np.testing.assert_array_equal(trace.alarm, d.alarms(trace.score),
+                                  err_msg="alarms differ from score > threshold")
 
 
+@_check("name each probe once, fix the names at reset(), compute each at least once, "
+        "and keep probes() free of side effects")
 def check_probes_are_named_once_and_do_not_change_the_run(detector: Detector) -> None:
     d, flight = _fitted(detector), _flight()
     plain, probed = run_detector(d, flight), run_detector(d, flight, probes=True)
-    _assert_same(plain, probed)
-    assert plain.probes == {}
-    assert len(probed.probes) == len(set(probed.probes))
+    _assert_same(plain, probed, what="the run with probes and without")
+    _expect(plain.probes == {}, "no probes kept when none are asked for",
+            sorted(plain.probes))
+    _expect(len(probed.probes) == len(set(probed.probes)), "each probe named once",
+            list(probed.probes))
     for name, values in probed.probes.items():
-        assert values.shape == probed.t.shape
-        assert np.isfinite(values).any(), f"probe {name} is never computed"
+        _expect(values.shape == probed.t.shape, f"probe {name} on every step",
+                f"shape {values.shape}")
+        _expect(np.isfinite(values).any(), f"probe {name} computed at least once",
+                "NaN on every step")
 
 
+@_check("make a run() of its own give update()'s scores and probes step by step (or "
+        "remove it: the base class steps update())")
 def check_batch_run_equals_streaming(detector: Detector) -> None:
     """A detector's own run() (batch or compiled) gives the scores and probes of update()
     step by step to rounding, and the same alarms wherever a score is not within
@@ -200,15 +281,21 @@ def check_batch_run_equals_streaming(detector: Detector) -> None:
     s = sample(_flight(), d.signals(), d.rate_hz)
     score, probes = d.run(s, probes=True)
     ref_score, ref_probes = Detector.run(d, s, probes=True)
-    np.testing.assert_allclose(score, ref_score, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(score, ref_score, rtol=1e-9, atol=1e-9,
+                               err_msg="run()'s scores differ from update()'s")
     thr = d.thresholds()
     tie = np.abs(ref_score - thr) <= 1e-9 * np.maximum(1.0, thr)
-    np.testing.assert_array_equal(d.alarms(score)[~tie], d.alarms(ref_score)[~tie])
-    assert list(probes) == list(ref_probes)
+    np.testing.assert_array_equal(d.alarms(score)[~tie], d.alarms(ref_score)[~tie],
+                                  err_msg="run()'s alarms differ from update()'s")
+    _expect(list(probes) == list(ref_probes), f"run()'s probes {list(ref_probes)}",
+            list(probes))
     for name in probes:
-        np.testing.assert_allclose(probes[name], ref_probes[name], rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose(probes[name], ref_probes[name], rtol=1e-9, atol=1e-9,
+                                   err_msg=f"probe {name} differs from update()'s")
 
 
+@_check("make snapshot() hold every attribute update() changes (the default copies "
+        "them all), or return None: the run is then never continued")
 def check_forked_run_equals_run(detector: Detector) -> None:
     """Continued from a :meth:`~.base.Detector.snapshot` (:func:`~.base.forks`), a
     flight that shares a prefix with the one forked gives the run from t = 0: the
@@ -225,19 +312,27 @@ def check_forked_run_equals_run(detector: Detector) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         other = load_flight(_scrambled_after(flight, cut_s, Path(tmp)))
     for fork in at.values():
-        assert fork.shared_by(sample(other, d.signals(), d.rate_hz), probes=True)
+        _expect(fork.shared_by(sample(other, d.signals(), d.rate_hz), probes=True),
+                "a fork taken before the change to be shared by the changed flight",
+                "not shared")
         forked = run_detector(d, other, probes=True, fork=fork)
         whole = run_detector(d, other, probes=True)
-        np.testing.assert_allclose(forked.score, whole.score, rtol=1e-9, atol=1e-9)
-        np.testing.assert_array_equal(forked.alarm, whole.alarm)
-        assert list(forked.probes) == list(whole.probes)
+        np.testing.assert_allclose(forked.score, whole.score, rtol=1e-9, atol=1e-9,
+                                   err_msg="the forked run's scores differ from the run's")
+        np.testing.assert_array_equal(forked.alarm, whole.alarm,
+                                      err_msg="the forked run's alarms differ from the run's")
+        _expect(list(forked.probes) == list(whole.probes), f"probes {list(whole.probes)}",
+                list(forked.probes))
         for name in whole.probes:
             np.testing.assert_allclose(forked.probes[name], whole.probes[name],
-                                       rtol=1e-9, atol=1e-9)
+                                       rtol=1e-9, atol=1e-9,
+                                       err_msg=f"the forked run's probe {name} differs")
     # the scrambled data must reach the detector, or the fork could not differ
-    assert not np.array_equal(whole.score, run_detector(d, flight).score, equal_nan=True)
+    _expect(not np.array_equal(whole.score, run_detector(d, flight).score, equal_nan=True),
+            "scores that change where the flight's data changes", "the same scores")
 
 
+@_check("make a run_many() of its own give each item's run() (or remove it)")
 def check_many_continued_runs_equal_each_run(detector: Detector) -> None:
     """:meth:`~.base.Detector.run_many` over flights continued from their forks
     (:func:`~.base.continue_forks`, as the injected grid is scored) gives each one's
@@ -255,12 +350,17 @@ def check_many_continued_runs_equal_each_run(detector: Detector) -> None:
             _FLIGHT.replace("_1_", f"_{i + 2}_"))) for i, share in enumerate((0.6, 0.8))]
     for forked in ({t: f} for t, f in at.items()):
         continued = continue_forks(d, others, forked)
-        assert sorted(continued) == sorted(o.id for o in others)
+        _expect(sorted(continued) == sorted(o.id for o in others),
+                f"a run of each flight {sorted(o.id for o in others)}", sorted(continued))
         for other in others:
             np.testing.assert_allclose(continued[other.id][1], run_detector(d, other).score,
-                                       rtol=1e-9, atol=1e-9)
+                                       rtol=1e-9, atol=1e-9,
+                                       err_msg=f"run_many()'s scores of {other.id} differ "
+                                               "from its run's")
 
 
+@_check("list in threshold_params only the parameters that set nothing but the "
+        "thresholds, and set the thresholds from them in rethreshold()")
 def check_rethreshold_equals_fit(detector: Detector) -> None:
     """For each of its :attr:`~.base.Detector.threshold_params`, a fitted detector given
     another value and :meth:`~.base.Detector.rethreshold` equals one fitted with it:
@@ -275,13 +375,19 @@ def check_rethreshold_equals_fit(detector: Detector) -> None:
         refit = _fit(type(d)(**{**d.get_params(), name: other}))
         moved = copy.deepcopy(d)
         setattr(moved, name, other)
-        assert moved.rethreshold() is moved
-        assert moved.fitted() == refit.fitted(), name
-        _assert_same(run_detector(moved, _flight()), run_detector(refit, _flight()))
+        _expect(moved.rethreshold() is moved, "rethreshold() to return self", "another "
+                "object")
+        _expect(moved.fitted() == refit.fitted(), f"with {name} = {other!r}, rethreshold() "
+                f"to learn what a fit learns: {refit.fitted()}", moved.fitted())
+        _assert_same(run_detector(moved, _flight()), run_detector(refit, _flight()),
+                     what=f"with {name} = {other!r}, the re-thresholded and refitted runs")
         if other != value:       # the value must reach the thresholds
-            assert not np.array_equal(moved.thresholds(), d.thresholds()), name
+            _expect(not np.array_equal(moved.thresholds(), d.thresholds()),
+                    f"other thresholds with {name} = {other!r}", "the same thresholds")
 
 
+@_check("let fit() learn from its data alone: start from nothing learned (the base "
+        "class forgets learned attributes; keep no other cache on the instance)")
 def check_a_refit_is_a_fresh_fit(detector: Detector) -> None:
     """One instance fitted on other data (the corpus less two flights), run, then fitted
     on the check's, equals a new one fitted on the check's: what fit learned, its
@@ -300,9 +406,12 @@ def check_a_refit_is_a_fresh_fit(detector: Detector) -> None:
         first = fit_token(d), forks(d, _flight(), [0.5 * _flight().duration_s])
     _fit(d)
     fresh = _fitted(detector)
-    assert d.fitted() == fresh.fitted()
-    assert fit_token(d) == fit_token(fresh)
-    _assert_same(run_detector(d, _flight()), run_detector(fresh, _flight()))
+    _expect(d.fitted() == fresh.fitted(), f"a refit to learn what a fresh fit learns: "
+            f"{fresh.fitted()}", d.fitted())
+    _expect(fit_token(d) == fit_token(fresh), "a refit's fit token to be a fresh fit's",
+            "another token")
+    _assert_same(run_detector(d, _flight()), run_detector(fresh, _flight()),
+                 what="the refitted and the freshly fitted runs")
     if first is not None and first[1] and first[0] != fit_token(d):
         fork = next(iter(first[1].values()))
         try:
@@ -310,9 +419,12 @@ def check_a_refit_is_a_fresh_fit(detector: Detector) -> None:
         except StaleStateError:
             pass
         else:
-            raise AssertionError("a state taken under another fit was continued")
+            raise AssertionError("expected StaleStateError for a state taken under "
+                                 "another fit; got a continued run")
 
 
+@_check("leave the per-flight maxima thresholds to MaximaThresholds, which raises "
+        "CalibrationError where they do not vary")
 def check_maxima_that_do_not_vary_cannot_calibrate(detector: Detector) -> None:
     """Thresholds from per-flight maxima (:class:`~.extremes.MaximaThresholds`): maxima
     that are all equal (a constant score) raise :class:`~.base.CalibrationError` from
@@ -330,21 +442,28 @@ def check_maxima_that_do_not_vary_cannot_calibrate(detector: Detector) -> None:
                 [{"f0": 2, "f1": 3}])
         except CalibrationError:
             continue
-        raise AssertionError(f"maxima that do not vary gave a threshold ({attempt})")
+        raise AssertionError(f"expected CalibrationError from {attempt}() on maxima "
+                             "that do not vary; got a threshold")
 
 
+@_check("seed every random draw from the parameters (a seed parameter), and reset "
+        "every running state in reset()")
 def check_deterministic(detector: Detector) -> None:
     d, flight = _fitted(detector), _flight()
-    _assert_same(run_detector(d, flight), run_detector(d, flight))
+    _assert_same(run_detector(d, flight), run_detector(d, flight), what="two runs")
 
 
+@_check("set every attribute update() changes back in reset(), and change nothing "
+        "fit() learned while running")
 def check_reset_forgets_the_previous_flight(detector: Detector) -> None:
     d = _fitted(detector)
     other = load_flight(next(p for p in sorted(_corpus().iterdir()) if "no_failure" in p.name))
     run_detector(d, other)
     fresh = _fit(type(d)(**d.get_params()))
-    assert fresh.fitted() == d.fitted()
-    _assert_same(run_detector(d, _flight()), run_detector(fresh, _flight()))
+    _expect(fresh.fitted() == d.fitted(), f"running to leave what fit learned: "
+            f"{fresh.fitted()}", d.fitted())
+    _assert_same(run_detector(d, _flight()), run_detector(fresh, _flight()),
+                 what="a run after another flight's and a fresh one")
 
 
 def _scrambled(cell: str) -> str:
@@ -371,6 +490,8 @@ def _scrambled_after(flight, cut_s: float, tmp: Path) -> Path:
     return altered
 
 
+@_check("compute each step's score from that step and earlier ones only (no look-ahead, "
+        "no whole-flight statistics), and return it from update() every step")
 def check_causal(detector: Detector) -> None:
     """Changing the data after time t changes no output before t (a detector that
     declares itself non-causal, a reference row, is skipped)."""
@@ -383,14 +504,18 @@ def check_causal(detector: Detector) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         changed = run_detector(d, load_flight(_scrambled_after(flight, cut_s, Path(tmp))))
     before = int(np.searchsorted(base.t, cut_s, side="right"))
-    assert before > 0
-    _assert_same(base, changed, upto=before)
+    _expect(before > 0, "grid steps before the change", "none")
+    _assert_same(base, changed, upto=before,
+                 what=f"with the data changed after {cut_s:.1f} s, the outputs before it")
     # the alteration must reach the detector, or this check could not fail
-    assert not np.array_equal(base.score[before:], changed.score[before:], equal_nan=True)
+    _expect(not np.array_equal(base.score[before:], changed.score[before:], equal_nan=True),
+            f"scores that change after {cut_s:.1f} s where the data does",
+            "the same scores (is every score NaN?)")
 
 
 #: every check, in the order they run
 CHECKS = (
+    check_signals_are_in_the_catalogue,
     check_constructor_stores_hyper_parameters_only,
     check_run_takes_the_base_arguments,
     check_calibrated_detectors_refuse_to_run_unfitted,
@@ -414,6 +539,7 @@ CHECKS = (
 
 #: the checks :func:`quick_check` runs: the contract's shape, and causality
 QUICK_CHECKS = (
+    check_signals_are_in_the_catalogue,
     check_constructor_stores_hyper_parameters_only,
     check_run_takes_the_base_arguments,
     check_each_channel_names_the_measured_signal_it_scores,
@@ -433,8 +559,11 @@ def quick_check(detector: Detector) -> None:
 
     Raises
     ------
+    UnknownSignalError
+        Where :meth:`~.base.Detector.signals` names a signal the catalogue lacks.
     ContractError
-        Naming the check that fails, what it found, and what to do."""
+        Naming the check that fails, what it expected, what came back, and what to
+        do."""
     for check in QUICK_CHECKS:
         if check is check_causal and not detector.causal:
             continue
@@ -445,7 +574,11 @@ def quick_check(detector: Detector) -> None:
                         "checks that need a fit are left to the real flights",
                         type(detector).__name__, e)
             return
-        except (AssertionError, ValueError, TypeError, NotImplementedError) as e:
+        except AssertionError as e:      # the check said what, and what to do
+            raise ContractError(f"{type(detector).__name__} fails the {e}\n(The contract: "
+                                "docs/adding-a-method.md; to score it anyway, "
+                                "evaluate(..., check=False))") from e
+        except (ValueError, TypeError, NotImplementedError) as e:
             raise ContractError(
                 f"{type(detector).__name__} fails the contract check "
                 f"{check.__name__.removeprefix('check_')}: {type(e).__name__}: {e}\n"

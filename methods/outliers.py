@@ -31,10 +31,14 @@ row.
 from __future__ import annotations
 
 import copy
+import functools
 import importlib
+import importlib.metadata
 import inspect
 import math
+import re
 from collections import deque
+from pathlib import Path
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
@@ -129,6 +133,23 @@ class OutlierModel(MaximaThresholds, Detector):
         if seed is not None and params.get(seed) is None:
             params[seed] = 0
         return cls(**params)
+
+    def check_params(self) -> None:
+        """The model builds: its class resolves in the library and takes ``params``."""
+        try:
+            self._build()
+        except ImportError as e:
+            raise ValueError(
+                f"{self.library} model {self._name()!r} cannot be built: it needs "
+                f"{e.name}, which alfa-bench does not install ({e}). What to do: "
+                f"pip install {e.name} (PyOD's deep models need torch), or name another "
+                "model") from None
+        except (AttributeError, TypeError) as e:
+            raise ValueError(
+                f"{self.library} model {self._name()!r} with params {self.params or {}} "
+                f"cannot be built: {type(e).__name__}: {e}. What to do: name a model class "
+                f"{self.library} has (its documentation lists them) and parameters it "
+                "takes") from None
 
     @staticmethod
     def _seed_name(cls) -> str | None:
@@ -283,9 +304,7 @@ class PyODDetector(OutlierModel):
     default_model = "IForest"
 
     def _resolve(self, name: str):
-        import pyod.models  # noqa: F401  (the models are modules of their own)
-
-        module = importlib.import_module(f"pyod.models.{_PYOD_MODULES.get(name, name.lower())}")
+        module = importlib.import_module(f"pyod.models.{pyod_module(name)}")
         return getattr(module, name)
 
     def _scaling(self, X):
@@ -344,9 +363,20 @@ def alone_ecdf_scores(train_sorted: np.ndarray, sums: np.ndarray, X: np.ndarray,
     return np.maximum(u_s, (u_l + u_r) / 2).sum(axis=1)
 
 
-#: PyOD's module of each model whose module is not its name in lower case
-_PYOD_MODULES = {"IForest": "iforest", "KNN": "knn", "LOF": "lof", "PCA": "pca",
-                 "HBOS": "hbos", "ECOD": "ecod", "COPOD": "copod", "OCSVM": "ocsvm"}
+@functools.cache
+def pyod_module(name: str) -> str:
+    """The module of ``pyod.models`` that defines the model class ``name``, found by its
+    source (``class <name>(``), so that nothing is imported but the model's own module;
+    :class:`AttributeError` where no module of the installed PyOD defines it."""
+    import pyod.models
+
+    folder = Path(pyod.models.__path__[0])
+    pattern = re.compile(rf"^class {re.escape(name)}\(", re.M)
+    found = sorted(f.stem for f in folder.glob("*.py") if pattern.search(f.read_text()))
+    if not found:
+        raise AttributeError(f"no module of pyod.models {importlib.metadata.version('pyod')} "
+                             f"defines a class {name}")
+    return found[0]
 
 
 class RiverDetector(OutlierModel):

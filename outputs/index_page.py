@@ -18,7 +18,7 @@ import pandas as pd
 from alfa_bench.analysis.blocks import FAULT_ORDER
 from alfa_bench.render import fmt
 
-from .tables import SILENT, SUBSET_NOTES
+from .tables import SIGNIFICANCE, SILENT, SUBSET_NOTES, ground_note, in_subset
 
 __all__ = ["index_html"]
 
@@ -30,6 +30,7 @@ body { font: 14px/1.35 system-ui, sans-serif; margin: 14px 28px; color: #222;
 h1 { font-size: 19px; margin: 0 0 2px; } h2 { font-size: 15px; margin: 10px 0 4px; }
 p { margin: 2px 0 6px; } table { border-collapse: collapse; font-size: 13px; }
 th, td { padding: 1px 8px; border-bottom: 1px solid #ddd; text-align: right; }
+td { white-space: nowrap; }
 th { background: #f3f3f3; } td:nth-child(2), th:nth-child(2) { text-align: left; }
 .row { display: flex; gap: 28px; align-items: flex-start; }
 img { max-height: 330px; max-width: 100%; border: 1px solid #eee; }
@@ -58,20 +59,52 @@ def _cells(r: dict) -> list[str]:
             f"{int(r['fault_free_false_alarms'])} of {int(r['fault_free_flights'])}",
             fmt(r["precision"], True, 1), fmt(r["recall"], True, 1),
             fmt(r["accuracy"], True, 1), fmt(r["mean_detection_s"]),
-            str(r.get("rank_range") or "-")]
+            str(r.get("rank_range") or "-"), _told_apart(r)]
+
+
+def _told_apart(r: dict) -> str:
+    """Whether the exact McNemar test tells a ranked run apart from the leader."""
+    p = r.get("vs_best_p")
+    if r["rank"] == 1 or fmt(p) == "-":
+        return "leader" if r["rank"] == 1 else "-"
+    return f"{'yes' if p < SIGNIFICANCE else 'no'}, p {p:.2f}"
+
+
+def _apart(table: pd.DataFrame) -> str:
+    """How many ranked runs the data cannot tell apart from the leader (exact McNemar)."""
+    if not len(table):
+        return ""
+    same = int(((table["rank"] > 1) & (table["vs_best_p"] >= SIGNIFICANCE)).sum())
+    return (f" The data cannot tell the leader apart from {same} of the other "
+            f"{len(table) - 1} ranked runs (exact McNemar, p ≥ {SIGNIFICANCE}).")
+
+
+def _left_out(left_out: pd.DataFrame, subset: str) -> str:
+    """The flights of ``subset`` off the common ground, and why, in a line."""
+    rows = in_subset(left_out, subset)
+    if not len(rows):
+        return ""
+    why = "; ".join(
+        f"<code>{html.escape(r['flight'])}</code> "
+        + ("refused at load" if r["runs"] == "every run" else
+           f"failed by {html.escape(str(r['runs']).replace(';', ', '))}")
+        for r in rows.to_dict(orient="records"))
+    return (f'<p class="note">Every run is ranked on the flights every run scored; left '
+            f'out: {why} (why: <a href="tables/failures.csv">failures.csv</a>).</p>')
 
 
 def index_html(comparison: pd.DataFrame, by_fault: pd.DataFrame, sweep_png: Path,
-               primary: str, run: str) -> str:
-    """The page (module docstring) from the run's ``comparison`` and ``by_fault``
-    tables and its sweep figure; ``run`` names the run in the footer."""
+               primary: str, run: str, left_out: pd.DataFrame) -> str:
+    """The page (module docstring) from the run's ``comparison``, ``by_fault`` and
+    ``left_out`` tables and its sweep figure; ``run`` names the run in the footer."""
     subset = comparison[comparison["subset"] == primary]
     table = subset[subset["rank"].notna()].sort_values("rank")
     d = fmt(float(comparison["deadline_s"].iloc[0]), digits=1)
-    flights = int(table["flights"].iloc[0]) if len(table) else 0
+    flights = ground_note(subset) if len(subset) else "0 flights"
     head = ["rank", "method", "family", f"faults detected ≤{d} s", "of them stable",
             "range, calibration resampled", "fault-free flights alarmed", "precision %",
-            "recall %", "accuracy %", "mean det. s", "rank range, resampled"]
+            "recall %", "accuracy %", "mean det. s", "rank range, resampled",
+            "told apart from the leader"]
     rows = [_row(head, "th")] + [_row(_cells(r)) for r in
                                  table.head(RANKED_ROWS).to_dict(orient="records")]
     more = len(table) - RANKED_ROWS
@@ -104,13 +137,14 @@ def index_html(comparison: pd.DataFrame, by_fault: pd.DataFrame, sweep_png: Path
 <html lang="en"><head><meta charset="utf-8"><title>alfa-bench: results</title>
 <style>{_STYLE}</style></head><body>
 <h1>alfa-bench: online fault detectors on the ALFA flights</h1>
-<p>Headline: subset <code>{html.escape(primary)}</code> ({flights} flights{note}).
+<p>Headline: subset <code>{html.escape(primary)}</code> ({flights}{note}).
 A fault counts as detected when the first alarm comes at most {d} s after its onset.
 Only honest runs (sensors and setpoints only) are ranked: by accuracy within the deadline
 (faults detected in time and fault-free flights left quiet, of all flights), then
 recall, then mean detection time.{quiet} A detection is <em>stable</em> when it
 survives when the calibration flights are resampled (most of the resamples; "not
-resampled": thresholds that need a refit).</p>
+resampled": thresholds that need a refit).{_apart(table)}</p>
+{_left_out(left_out, primary)}
 <p class="links"><a href="tables/comparison.html">every run and subset</a>
 <a href="tables/stability.md">stability</a> <a href="tables/per_flight.md">per flight</a>
 <a href="../paper/build/paper.md">the paper</a> <a href="report.html">the Snakemake report</a></p>

@@ -8,7 +8,11 @@ unknown key or a missing file is an error, so the text cannot quote a number the
 run did not produce.
 
 Keys (``<m>`` a method run, ``<s>`` a subset, ``<sig>`` a catalogue signal, ``<c>`` a
-fault class): ``deadline`` (s), ``flights:<s>``, ``faultfree:<s>``, ``faultflights:<s>``;
+fault class): ``deadline`` (s), ``flights:<s>`` (the subset's flights on the common
+ground, the flights every run scored), ``ground:<s>`` (the subset's size and, where a
+flight was left out, its common ground: "26 flights, 22 on the common ground, 4 left
+out"), ``leftout`` (the flights left out and why, or "none"), ``faultfree:<s>``,
+``faultflights:<s>``;
 scored with the deadline: ``precision:<m>:<s>``, ``recall:<m>:<s>``,
 ``accuracy:<m>:<s>`` (in %), ``detected:<m>:<s>`` (faults detected in time),
 ``meandet:<m>:<s>``, ``maxdet:<m>:<s>`` (s); by the paper's rule:
@@ -66,7 +70,7 @@ from alfa_bench.analysis.reference import ICRA2019_SUMMARY
 from alfa_bench.data import SIGNALS
 from alfa_bench.render import latex_escape
 
-from .tables import SIGNIFICANCE
+from .tables import SIGNIFICANCE, ground_note
 
 __all__ = ["latex_macros", "latex_keys", "paper_numbers", "render_markdown", "sensor_numbers"]
 
@@ -98,14 +102,16 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.Dat
                   ceiling: pd.DataFrame | None = None,
                   calibration: pd.DataFrame | None = None,
                   stability: dict | None = None,
-                  study: pd.DataFrame | None = None) -> dict[str, str]:
+                  study: pd.DataFrame | None = None,
+                  left_out: pd.DataFrame | None = None) -> dict[str, str]:
     """Every quotable number, as text, by key (see the module docstring). A configured
     run (``methods``) with no score on a subset (``subsets``), because every flight of
     it was excluded, quotes "n/a". ``sensors`` holds the ``detectability``,
     ``isolation_sensors`` and ``isolation_actuators`` tables; ``primary`` is the
     headline subset; ``ceiling`` the detectability ceiling's table; ``study`` the public
     study's reproduction against its published table
-    (:func:`~alfa_bench.analysis.public_study.against_study`)."""
+    (:func:`~alfa_bench.analysis.public_study.against_study`); ``left_out`` the flights
+    off the common ground (``left_out.csv``)."""
     out = {f"{k}:{m}:{s}": "n/a" for k in _PER_RUN for m in methods for s in subsets}
     out |= {f"paper:{k}": (_pct if k in ("precision", "recall", "accuracy") else _sec)(
         ICRA2019_SUMMARY[key])
@@ -135,7 +141,9 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.Dat
         rank = r.get("rank_range")
         out[f"rankrange:{m}:{s}"] = rank if isinstance(rank, str) else "n/a"
     out["primary"] = primary or "none"
+    out["leftout"] = _left_out_words(left_out)
     for s, table in comparison.groupby("subset", sort=False):
+        out[f"ground:{s}"] = ground_note(table)
         best = table[table["rank"] == 1]
         out[f"best:{s}"] = best["method"].iloc[0] if len(best) else "none"
         out[f"bestaccuracy:{s}"] = _pct(best["accuracy"].iloc[0]) if len(best) else "n/a"
@@ -272,6 +280,18 @@ def sensor_numbers(tables: dict, runs) -> dict[str, str]:
         if name == "isolation_sensors":
             out["sensorfaults"] = str(table["flight"].nunique())
     return out
+
+
+def _left_out_words(left_out: pd.DataFrame | None) -> str:
+    """The flights off the common ground and why, in words; "none" without any."""
+    if left_out is None or not len(left_out):
+        return "none"
+    return "; ".join(
+        f"{r['flight']} ("
+        + ("refused at load" if r["runs"] == "every run" else
+           f"failed by {str(r['runs']).replace(';', ', ')} at {r['stage']}")
+        + ")" for r in left_out.to_dict(orient="records")
+    ) + " (why: results/tables/failures.csv)"
 
 
 def latex_macros(numbers: dict[str, str]) -> str:

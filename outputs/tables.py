@@ -20,9 +20,13 @@ the paired test. ``by_fault``: the layout of Keipour et al.'s Table I per method
 subset: fault class, flights, flight time, detections, mean and max detection time,
 accuracy, and a total row.
 
-A flight that could not be read (for every method, or for one) is not scored; the
-``excluded`` column of the summary and comparison counts such flights of the subset,
-and ``results/tables/failures.csv`` (:func:`failures_table`) says why.
+Every table compares like with like: runs are scored on the *common ground*, the
+labelled flights every run scored (:func:`common_ground`). A flight refused at load
+(for every run), or one that some run failed on (a fold it could not calibrate), is
+left out for all of them; ``results/tables/left_out.csv`` lists those flights with
+the runs that failed and why, the ``excluded`` column of the summary and comparison
+counts them per subset, and ``failed_flights`` counts a run's own failures, which
+flag it. ``results/tables/failures.csv`` (:func:`failures_table`) holds every error.
 """
 
 from __future__ import annotations
@@ -39,9 +43,10 @@ from alfa_bench.analysis.stability import pool_summaries, stability_table
 from alfa_bench.data import FAILURE_COLUMNS, subset_flights
 from alfa_bench.render import Section, fmt, latex_tables, markdown
 
-__all__ = ["SIGNIFICANCE", "SILENT", "by_fault_latex",
+__all__ = ["LEFT_OUT_COLUMNS", "SIGNIFICANCE", "SILENT", "by_fault_latex",
            "by_fault_markdown", "by_fault_table", "comparison_latex", "comparison_markdown",
-           "comparison_notes", "comparison_table", "configurations", "failures_table",
+           "common_ground", "comparison_notes", "comparison_table", "configurations",
+           "failures_table", "ground_note", "in_subset", "left_out_markdown",
            "refit_markdown", "stability_markdown", "summary_latex", "summary_markdown",
            "summary_table", "unscored_notes"]
 
@@ -60,37 +65,89 @@ def failures_table(load: pd.DataFrame, per_method: list[pd.DataFrame]) -> pd.Dat
     return pd.concat(frames, ignore_index=True).reindex(columns=[*FAILURE_COLUMNS, "subsets"])
 
 
-def _excluded(failures: pd.DataFrame | None, subset: str, flights: list[str],
-              method: str) -> list[str]:
+#: the columns of ``left_out.csv``: a flight off the common ground, the subsets it is
+#: in, the stages it failed at, the runs that failed on it ("every run" at load) and
+#: the first error
+LEFT_OUT_COLUMNS = ["flight", "subsets", "stage", "runs", "error"]
+
+
+def _failures(failures: pd.DataFrame | None) -> pd.DataFrame:
+    columns = [*FAILURE_COLUMNS, "subsets"]
     if failures is None or not len(failures):
-        return []
-    f = failures.fillna("")
-    at_load = f[(f["stage"] == "load") & f["subsets"].astype(str).str.split(";").apply(
-        lambda s: subset in s)]["flight"]
-    member = set(flights)
-    own = f[(f["method"] == method) & f["flight"].isin(member)]["flight"]
-    return list(dict.fromkeys([*at_load, *own]))
+        return pd.DataFrame(columns=columns)
+    f = failures.reindex(columns=columns)
+    return f.astype(object).where(f.notna(), "").astype({"subsets": str, "method": str})
+
+
+def common_ground(records: list[dict], manifest: pd.DataFrame,
+                  failures: pd.DataFrame | None = None) -> tuple[list[dict], pd.DataFrame]:
+    """The records of the flights every run scored, and the flights left out of that
+    common ground (:data:`LEFT_OUT_COLUMNS`): those refused at load, then those some run
+    failed on, each with the runs that did and the first error.
+
+    A run that scored no flight at all does not shrink the common ground (it has no row;
+    :func:`unscored_notes` names it). Every labelled flight a run has no record of must
+    be one of its ``failures``: else :class:`ValueError`."""
+    f = _failures(failures)
+    by_method: dict[str, set[str]] = {}
+    for r in records:
+        by_method.setdefault(r["method"], set()).add(r["flight"])
+    labelled = manifest.loc[manifest["ground_truth"], "flight"].tolist()
+    own = {m: set(g["flight"]) for m, g in f[f["method"] != ""].groupby("method")}
+    for method, scored in by_method.items():
+        missing = [x for x in labelled if x not in scored and x not in own.get(method, ())]
+        if missing:
+            raise ValueError(f"method {method}: no detection for {len(missing)} flight(s), "
+                             f"e.g. {missing[0]}, and no failure reported")
+    common = set(labelled).intersection(*by_method.values())
+    rows = [{"flight": r["flight"], "subsets": r["subsets"], "stage": "load",
+             "runs": "every run", "error": r["error"]}
+            for r in f[f["stage"] == "load"].to_dict(orient="records")]
+    subsets = manifest.set_index("flight")["subsets"]
+    for flight in (x for x in labelled if x not in common):
+        mine = f[(f["flight"] == flight) & (f["method"] != "")]
+        rows.append({"flight": flight, "subsets": subsets[flight],
+                     "stage": ";".join(dict.fromkeys(mine["stage"])),
+                     "runs": ";".join(sorted(set(mine["method"]))),
+                     "error": mine["error"].iloc[0] if len(mine) else ""})
+    return ([r for r in records if r["flight"] in common],
+            pd.DataFrame(rows, columns=LEFT_OUT_COLUMNS))
+
+
+def in_subset(rows: pd.DataFrame, subset: str) -> pd.DataFrame:
+    """The ``rows`` (of ``failures.csv`` or ``left_out.csv``) whose ``subsets`` name
+    ``subset``."""
+    return rows[rows["subsets"].fillna("").astype(str).str.split(";").apply(
+        lambda s: subset in s)]
 
 
 def _records_for(records: list[dict], manifest: pd.DataFrame, subset: str,
-                 failures: pd.DataFrame | None = None) -> dict[str, tuple[list[dict], list[str]]]:
-    """method -> (records of the subset's flights, the subset's flights it excluded);
-    a flight without a record must be one of ``failures``."""
+                 failures: pd.DataFrame | None = None) -> dict[str, tuple[list[dict], int]]:
+    """method -> (its records of the subset's flights on the common ground
+    (:func:`common_ground`), the flights of the subset it failed on itself); the subset's
+    flights off the common ground are ``excluded`` from every run alike."""
+    records, _ = common_ground(records, manifest, failures)
     flights = subset_flights(manifest, subset)
+    f = _failures(failures)
+    member = f[f["flight"].isin(flights) & (f["method"] != "")]
+    failed = member.groupby("method")["flight"].nunique().to_dict()
     by_method: dict[str, dict[str, dict]] = {}
     for r in records:
         by_method.setdefault(r["method"], {})[r["flight"]] = r
     out = {}
     for method, recs in by_method.items():
-        excluded = _excluded(failures, subset, flights, method)
-        missing = [f for f in flights if f not in recs and f not in excluded]
-        if missing:
-            raise ValueError(f"method {method}: no detection for {len(missing)} flight(s) of "
-                             f"subset {subset}, e.g. {missing[0]}, and no failure reported")
-        scored = [recs[f] for f in flights if f in recs]
+        scored = [recs[x] for x in flights if x in recs]
         if scored:             # a subset with no flight scored has no row to show
-            out[method] = (scored, excluded)
+            out[method] = (scored, int(failed.get(method, 0)))
     return out
+
+
+def _left_out_count(manifest: pd.DataFrame, subset: str, scored: int,
+                    failures: pd.DataFrame | None) -> int:
+    """The subset's flights off the common ground: refused at load, or not scored."""
+    f = _failures(failures)
+    at_load = in_subset(f[f["stage"] == "load"], subset)
+    return len(subset_flights(manifest, subset)) - scored + len(at_load)
 
 
 def _scores(recs: list[dict], deadline_s: float) -> tuple[list[str], dict]:
@@ -105,11 +162,13 @@ def summary_table(records: list[dict], manifest: pd.DataFrame, subsets, deadline
                   failures: pd.DataFrame | None = None) -> pd.DataFrame:
     rows = []
     for subset in subsets:
-        for method, (recs, excluded) in _records_for(records, manifest, subset,
-                                                     failures).items():
+        for method, (recs, failed) in _records_for(records, manifest, subset,
+                                                   failures).items():
             _, s = _scores(recs, deadline_s)
             rows.append({"method": method, "subset": subset, "block": block(recs[0]),
-                         "deadline_s": deadline_s, **s, "excluded": len(excluded)})
+                         "deadline_s": deadline_s, **s,
+                         "excluded": _left_out_count(manifest, subset, len(recs), failures),
+                         "failed_flights": failed})
     return pd.DataFrame(rows)
 
 
@@ -148,22 +207,22 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
     calibration protocol, the flights excluded, and the exact McNemar test against the
     best honest method on the flights both scored.
 
-    Ranks compare like with like: an honest run is ranked only if it scored every
-    flight that any honest run scored of the subset, and armed on at least one;
-    otherwise ``not_ranked`` says why (``scored on k of n``, ``never armed``) and it
-    follows the ranked ones, without a rank.
+    Ranks compare like with like: every run is scored on the common ground
+    (:func:`common_ground`), and a run that failed on flights the others scored is
+    ranked there all the same, flagged by ``failed_flights``. An honest run that never
+    armed is not ranked: ``not_ranked`` says so and it follows the ranked ones.
 
     Under resampled calibration pools (:mod:`alfa_bench.analysis.stability`): the
     stable detections (survival at least ``stable``), the central ``interval`` of the
     in-time detections over the pools, and ``rank_range``, the ranks a ranked run
     takes over the pools (the other ranked runs re-scored under the same pools)."""
-    pooled = stability_table(records, manifest, subsets, deadline_s, stable, interval
-                             ).set_index(["subset", "method"])
+    pooled = stability_table(common_ground(records, manifest, failures)[0], manifest, subsets,
+                             deadline_s, stable, interval).set_index(["subset", "method"])
     rows = []
     for subset in subsets:
         runs = []
-        for method, (recs, excluded) in _records_for(records, manifest, subset,
-                                                     failures).items():
+        for method, (recs, failed) in _records_for(records, manifest, subset,
+                                                   failures).items():
             outcomes, s = _scores(recs, deadline_s)
             named, hits = _isolation(recs, outcomes)
             free = [r for r in recs if r["fault_class"] == "none"]
@@ -180,20 +239,18 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
                 "armed_flights": sum(any(v is not None for v in r["pair_armed_s"].values())
                                      for r in recs),
                 "isolation": named / hits if hits else math.nan,
-                "excluded": len(excluded),
+                "excluded": _left_out_count(manifest, subset, len(recs), failures),
+                "failed_flights": failed,
                 **{k: pooled.at[(subset, method), k]
                    for k in ("stable_detections", "detections_low", "detections_high")},
             }, recs))
         honest = sorted((r[:2] for r in runs if r[1]["block"] == "honest"),
                         key=lambda r: _rank_key(r[1]))
-        common = set().union(*(set(c) for c, _ in honest))
         recs_of = {row["method"]: recs for _, row, recs in runs}
         runs = [r[:2] for r in runs]
-        for correct, row in runs:
-            row["not_ranked"] = ("" if row["block"] != "honest" else
-                                 f"scored on {len(correct)} of {len(common)}"
-                                 if set(correct) != common else
-                                 "never armed" if row["armed_flights"] == 0 else "")
+        for _, row in runs:
+            row["not_ranked"] = ("never armed" if row["block"] == "honest"
+                                 and row["armed_flights"] == 0 else "")
         ranked = [r for r in honest if not r[1]["not_ranked"]]
         for i, (_, row) in enumerate(ranked, 1):
             row["rank"] = i
@@ -411,10 +468,13 @@ def _comparison_sections(comparison: pd.DataFrame, primary: str | None = None
                       f"p = {p:.3f}" + ("" if p < SIGNIFICANCE else " (cannot tell apart)"))
             rank = r.get("rank")
             why = r.get("not_ranked")
+            failed = int(r.get("failed_flights") or 0)
             return [why if isinstance(why, str) and why else
                     "-" if fmt(rank) == "-" else str(int(rank)),
                     r["method"] + (" (no better than silence)"
-                                   if r.get("beats_silence") is False else ""),
+                                   if r.get("beats_silence") is False else "")
+                    + (f" (FLAGGED: failed on {failed} flight{'s' * (failed > 1)}; "
+                       "ranked on the common ground)" if failed else ""),
                     r["detector"], r["calibration"],
                     _rate(r, "precision"), _rate(r, "recall"), _rate(r, "accuracy"),
                     _stable(r), r["rank_range"] if isinstance(r.get("rank_range"), str) else "-",
@@ -435,14 +495,41 @@ def _comparison_sections(comparison: pd.DataFrame, primary: str | None = None
                                "mean_detection_s_paper": paper["mean_detection_s"],
                                "fault_free_flights": free,
                                "fault_free_false_alarms": free - paper["tn"]}))
-        # the subset's size: the first method's scored and excluded flights
-        first = table.iloc[0]
-        flights = int(first["flights"]) + int(first.get("excluded", 0))
         head = "Headline: subset" if subset == primary else "Subset"
         note = f"; {SUBSET_NOTES[subset]}" if subset in SUBSET_NOTES else ""
-        out.append((f"{head} `{subset}` ({flights} flights{note}; deadline {d} s)", header,
-                    rows))
+        out.append((f"{head} `{subset}` ({ground_note(table)}{note}; deadline {d} s)",
+                    header, rows))
     return out
+
+
+def ground_note(table: pd.DataFrame) -> str:
+    """A subset's size and its common ground, from its rows of the comparison or
+    summary: ``26 flights`` or ``26 flights, 22 on the common ground, 4 left out``."""
+    first = table.iloc[0]
+    scored, left = int(first["flights"]), int(first.get("excluded", 0))
+    return (f"{scored + left} flights" if not left else
+            f"{scored + left} flights, {scored} on the common ground, {left} left out")
+
+
+def left_out_markdown(left_out: pd.DataFrame, subsets) -> str:
+    """The flights of ``subsets`` off the common ground (:func:`common_ground`), the
+    subsets they are in, and why; empty when no flight is left out."""
+    lines = []
+    for r in left_out.to_dict(orient="records"):
+        mine = [s for s in subsets if s in str(r["subsets"] or "").split(";")]
+        if not mine:
+            continue
+        who = ("refused at load, for every run" if r["runs"] == "every run" else
+               f"failed by {', '.join(f'`{m}`' for m in str(r['runs']).split(';'))} "
+               f"({r['stage']}), so left out for every run")
+        lines.append(f"- `{r['flight']}` (of {', '.join(f'`{s}`' for s in mine)}): {who}: "
+                     f"{r['error']}")
+    if not lines:
+        return ""
+    return ("\n### Flights left out of the common ground\n\n"
+            "Every run is scored and ranked on the flights every run scored; these were "
+            "not (every error: [`failures.csv`](failures.csv), per flight: "
+            "[`left_out.csv`](left_out.csv)).\n\n" + "\n".join(lines) + "\n")
 
 
 def comparison_notes(comparison: pd.DataFrame) -> str:
@@ -505,14 +592,14 @@ def unscored_notes(comparison: pd.DataFrame, failures: pd.DataFrame, manifest: p
 
 
 def comparison_markdown(comparison: pd.DataFrame, unscored: str = "", primary: str | None = None,
-                        audit: str = "") -> str:
+                        audit: str = "", left_out: str = "") -> str:
     """``audit`` (what the leakage audit finds on the ``primary`` subset), then one table
     per subset, in blocks, the ``primary`` one titled the headline; the ICRA 2019 paper's
     row under ``icra22``; which differences the data cannot tell apart; then
-    ``unscored`` (:func:`unscored_notes`)."""
+    ``left_out`` (:func:`left_out_markdown`) and ``unscored`` (:func:`unscored_notes`)."""
     return (audit + markdown(_comparison_sections(comparison, primary))
             + "\n### Which differences the data can tell\n\n" + comparison_notes(comparison)
-            + unscored)
+            + left_out + unscored)
 
 
 def comparison_latex(comparison: pd.DataFrame) -> str:

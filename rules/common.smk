@@ -4,9 +4,12 @@ import sys
 from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
+from snakemake.logging import logger
 
 from alfa_bench.workflow.preflight import alfa_dir_problem, failure_message, stop
 from alfa_bench.workflow.dependencies import module_sources
+from alfa_bench.workflow.logs import failed_flights_line
+from alfa_bench.workflow.stale import remove, stale_results
 from alfa_bench.workflow.resources import count_flights, job_resources
 from alfa_bench.outputs.provenance import RUN_FILE
 from alfa_bench.data import SIGNALS, resolve_alfa_dir
@@ -32,6 +35,9 @@ INJECTED_PROCESSED = "results/injected/processed"
 for _name, _spec in config["methods"].items():
     try:
         _detector = make_detector(_spec["detector"], _spec.get("params"))
+        # a library's model by name, imported: once, here, not in every job
+        if workflow.is_main_process:
+            _detector.check_params()
     except (KeyError, TypeError, ValueError) as _e:
         raise WorkflowError(f"config methods.{_name}: {_e}") from None
     # a misspelt signal is the config's error, not every flight's bad data
@@ -42,6 +48,14 @@ for _name, _spec in config["methods"].items():
     if not _detector.causal and _spec.get("role", "method") != "reference":
         raise WorkflowError(f"config methods.{_name}: detector {_spec['detector']!r} is not "
                             "causal, so it can only be a reference row (role: reference)")
+
+
+# what a run taken out of the config left: named once, removed on request
+STALE = stale_results("results", METHODS)
+if STALE and workflow.is_main_process:
+    logger.warning(f"{len(STALE)} result folder(s) or file(s) no configured run writes any "
+                   f"more, e.g. {STALE[0]}: nothing reads them; `snakemake remove_stale` "
+                   "removes them")
 
 
 def detector_code(method):

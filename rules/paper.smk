@@ -30,6 +30,7 @@ rule paper_sources:
         ceiling="results/tables/ceiling.csv",
         calibration="results/tables/calibration.csv",
         against_study="results/tables/against_study.csv",
+        left_out="results/tables/left_out.csv",
         tex=PAPER_DIR / "paper.tex",
         markdown=PAPER_DIR / "paper.template.md",
     output:

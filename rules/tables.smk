@@ -1,3 +1,9 @@
+# the run ends on one line naming the flights it could not score on, when there are any
+onsuccess:
+    if _failed := failed_flights_line():
+        logger.warning(_failed)
+
+
 rule tables:
     input:
         manifest="results/flights.csv",
@@ -7,6 +13,8 @@ rule tables:
     output:
         failures=report("results/tables/failures.csv", caption="../report/failures.rst",
                         category="Comparison"),
+        # the flights off the common ground every run is ranked on, and why
+        left_out="results/tables/left_out.csv",
         summary="results/tables/summary.csv",
         by_fault="results/tables/by_fault.csv",
         comparison=report("results/tables/comparison.csv", caption="../report/comparison.rst",
@@ -45,6 +53,7 @@ rule index_page:
         manifest="results/flights.csv",
         comparison="results/tables/comparison.csv",
         by_fault="results/tables/by_fault.csv",
+        left_out="results/tables/left_out.csv",
         sweep="results/figures/sweep.png",
     output:
         "results/index.html",

@@ -19,7 +19,8 @@ numbers = paper_numbers(read_table(sm.input.comparison), read_table(sm.input.swe
                         ceiling=read_table(sm.input.ceiling),
                         calibration=read_table(sm.input.calibration),
                         stability=sm.config["stability"],
-                        study=read_table(sm.input.against_study))
+                        study=read_table(sm.input.against_study),
+                        left_out=read_table(sm.input.left_out))
 unknown = latex_keys(Path(sm.input.tex).read_text()) - set(numbers)
 if unknown:
     raise KeyError(f"{sm.input.tex} quotes results no run defines: {sorted(unknown)}")

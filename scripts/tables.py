@@ -15,10 +15,12 @@ from alfa_bench.outputs.tables import (
     by_fault_latex,
     by_fault_markdown,
     by_fault_table,
+    common_ground,
     comparison_latex,
     comparison_markdown,
     comparison_table,
     failures_table,
+    left_out_markdown,
     stability_markdown,
     summary_latex,
     summary_markdown,
@@ -41,7 +43,13 @@ by_fault = by_fault_table(records, manifest, sm.params.subsets, deadline, failur
 stability = sm.params.stability
 comparison = comparison_table(records, manifest, sm.params.subsets, deadline, failures,
                               stability["stable"], stability["interval"])
-pooled = stability_table(records, manifest, sm.params.subsets, deadline, stability["stable"],
+common, left_out = common_ground(records, manifest, failures)
+left_out.to_csv(sm.output.left_out, index=False)
+if len(left_out):
+    logging.getLogger("alfa_bench.analysis").warning(
+        "%d flight(s) left out of the common ground every run is ranked on: %s (see "
+        "results/tables/left_out.csv)", len(left_out), ", ".join(left_out["flight"]))
+pooled = stability_table(common, manifest, sm.params.subsets, deadline, stability["stable"],
                          stability["interval"])
 pooled.to_csv(sm.output.stability, index=False)
 folds = calibration_table(records)
@@ -52,12 +60,13 @@ by_fault.to_csv(sm.output.by_fault, index=False)
 comparison.to_csv(sm.output.comparison, index=False)
 Path(sm.output.summary_md).write_text(summary_markdown(summary))
 Path(sm.output.by_fault_md).write_text(by_fault_markdown(by_fault))
-audit = audit_note(read_table(sm.input.leakage), manifest, sm.params.primary)
+audit = audit_note(read_table(sm.input.leakage), manifest, sm.params.primary,
+                   failures[failures["stage"] == "load"])
 if audit.startswith("**WARNING"):
     logging.getLogger("alfa_bench.analysis").warning(audit.replace("*", "").strip())
 Path(sm.output.comparison_md).write_text(comparison_markdown(
     comparison, unscored_notes(comparison, failures, manifest, sm.params.subsets),
-    sm.params.primary, audit))
+    sm.params.primary, audit, left_out_markdown(left_out, sm.params.subsets)))
 Path(sm.output.comparison_html).write_text(markdown_html(
     Path(sm.output.comparison_md).read_text(), "alfa-bench: comparison"))
 Path(sm.output.summary_tex).write_text(summary_latex(summary))

@@ -29,7 +29,7 @@ import numpy as np
 
 from alfa_bench.data import AlfaDataError, find_flights, load_flight
 from alfa_bench.data.manifest import manifest_row
-from alfa_bench.data.signals import check_physical
+from alfa_bench.data.signals import check_signals
 from alfa_bench.methods import make_detector, run_detector
 
 NAME = "carbonZ_2018-07-18-15-53-31_1_engine_failure"
@@ -227,7 +227,7 @@ def outcome(folder: Path) -> tuple[str, object]:
         if not find_flights(folder.parent):
             return "skipped", None
         flight = load_flight(folder)
-        check_physical(flight)
+        check_signals(flight)
         row = manifest_row(flight)
         if not row["ground_truth"]:
             return "excluded", flight

@@ -128,10 +128,14 @@ def test_a_subset_without_flights_has_no_rows_and_a_fully_excluded_run_is_named(
     assert "`a`" not in notes and "`emr`" not in notes
 
 
-def test_ranks_compare_runs_on_the_same_flights_and_never_a_silent_one(corpus_manifest):
-    """A run that scored fewer flights than the others, or never armed, is listed after
-    the ranked ones with the reason, however its accuracy compares."""
+def test_runs_are_ranked_on_the_common_ground_and_a_run_that_failed_is_flagged(
+        corpus_manifest):
+    """A run that failed on a flight the others scored is ranked all the same, on the
+    flights every run scored, and flagged; that flight is left out for every run, with
+    the run that failed and why. A run that never armed is not ranked."""
     import pandas as pd
+
+    from alfa_bench.outputs.tables import common_ground, comparison_markdown
 
     flights = corpus_manifest.loc[corpus_manifest["ground_truth"]]
     first = flights["flight"].iloc[0]
@@ -143,15 +147,33 @@ def test_ranks_compare_runs_on_the_same_flights_and_never_a_silent_one(corpus_ma
         if r.flight != first:       # perfect, but on one flight fewer
             records.append(_record("partial", r.flight, onset,
                                    None if onset is None else onset + 0.5))
-    failures = pd.DataFrame([{"flight": first, "stage": "detect", "method": "partial",
-                              "subsets": ""}])
+    failures = pd.DataFrame([{"flight": first, "stage": "calibration", "method": "partial",
+                              "error": "too few fault-free flights", "subsets": ""}])
     table = comparison_table(records, corpus_manifest, ["all"], 5.0, failures)
     table = table.set_index("method")
-    assert table.loc["fair", "rank"] == 1
-    assert math.isnan(table.loc["partial", "rank"]) and math.isnan(table.loc["silent", "rank"])
-    assert table.loc["partial", "not_ranked"] == f"scored on {len(flights) - 1} of {len(flights)}"
+    assert table.loc["partial", "rank"] == 1 and table.loc["fair", "rank"] == 2
+    assert (table["flights"] == len(flights) - 1).all() and (table["excluded"] == 1).all()
+    assert table.loc["partial", "failed_flights"] == 1 and table.loc["fair", "failed_flights"] == 0
+    assert math.isnan(table.loc["silent", "rank"])
     assert table.loc["silent", "not_ranked"] == "never armed"
-    assert list(table.index) == ["fair", "partial", "silent"]
+    assert list(table.index) == ["partial", "fair", "silent"]
+    kept, left_out = common_ground(records, corpus_manifest, failures)
+    assert first not in {r["flight"] for r in kept}
+    assert left_out.to_dict(orient="records") == [{
+        "flight": first, "subsets": corpus_manifest.set_index("flight").at[first, "subsets"],
+        "stage": "calibration", "runs": "partial", "error": "too few fault-free flights"}]
+    text = comparison_markdown(table.reset_index())
+    assert "partial (FLAGGED: failed on 1 flight; ranked on the common ground)" in text
+    assert f"({len(flights)} flights, {len(flights) - 1} on the common ground, 1 left out" in text
+
+
+def test_a_run_with_no_record_and_no_failure_is_an_error(corpus_manifest):
+    from alfa_bench.outputs.tables import common_ground
+
+    flights = corpus_manifest.loc[corpus_manifest["ground_truth"], "flight"]
+    records = [_record("a", f, None, None) for f in flights[1:]]
+    with pytest.raises(ValueError, match="no detection for 1 flight"):
+        common_ground(records, corpus_manifest)
 
 
 def test_a_run_no_better_than_silence_is_flagged(corpus_manifest):

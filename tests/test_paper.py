@@ -141,8 +141,9 @@ def test_latex_tables_escape_and_label():
             "0 / 2, p = 0.500 "
             "(cannot tell apart) & 10 & 1 \\\\") in tex
     assert "MARKED: reads what the fault emulation writes" in tex
-    assert ("(11 flights; includes the emergency-trajectory flights, whose commands switch "
-            "at onset; deadline 5.0 s)") in tex
+    assert ("(11 flights, 10 on the common ground, 1 left out; includes the "
+            "emergency-trajectory flights, whose commands switch at onset; deadline 5.0 s)"
+            ) in tex
 
 
 def test_sensor_fault_numbers_come_from_the_grid_and_the_isolation_tables():

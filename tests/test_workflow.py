@@ -9,15 +9,28 @@ from pathlib import Path
 
 import pytest
 import yaml
-from broken import GT, IMU, ROLL, _gap, _late_start, edit, set_cell, shift_time
+from broken import (
+    GT,
+    IMU,
+    ROLL,
+    _gap,
+    _late_start,
+    edit,
+    set_cell,
+    shift_time,
+    topic_file,
+)
 from unavailable import unavailable
 from workflow_runs import GRID, REPO, SNAKEMAKE, assert_same_results, run_workflow
 
 from alfa_bench.data.synthetic import write_flight
-from alfa_bench.methods import REGISTRY, make_detector
+from alfa_bench.methods import REGISTRY
 from alfa_bench.outputs.provenance import RUN_FILE, read_provenance, read_table
 from alfa_bench.outputs.records import INJECTED_RECORDS, RUN_RECORD, iter_records, read_run_record
 from alfa_bench.outputs.traces import read_trace
+
+YAW, WIND, ERRORS = ("mavros-nav_info-yaw", "mavros-wind_estimation",
+                     "mavros-nav_info-errors")
 
 # Snakemake or pip in a subprocess, minutes in all: `pytest -m "not workflow"` skips them
 pytestmark = pytest.mark.workflow
@@ -321,7 +334,7 @@ def test_two_runs_are_byte_identical(runs):
 @pytest.fixture(scope="module")
 def broken_corpus(corpus, tmp_path_factory):
     """The corpus plus a flight that cannot be read at all and one with a 5 s gap in
-    its IMU topic, which only the methods reading the IMU cannot use."""
+    its IMU topic."""
     root = tmp_path_factory.mktemp("broken")
     shutil.copytree(corpus, root / "processed")
     unreadable = write_flight(root / "processed", "carbonZ_2018-09-11-14-22-07_2_no_failure",
@@ -331,28 +344,6 @@ def broken_corpus(corpus, tmp_path_factory):
                        onset_s=40.0, fault_topic="failure_status-elevator", seed=8)
     edit(IMU, _gap)(gap)
     return root, unreadable.name, gap.name
-
-
-def test_broken_flights_are_excluded_and_reported(broken_corpus, tmp_path):
-    root, unreadable, gap = broken_corpus
-    run_workflow(tmp_path, root, target="results/tables/summary.csv")
-    failures = read_table(tmp_path / "results/tables/failures.csv", keep_default_na=False)
-    config = yaml.safe_load((REPO / "config/config.yaml").read_text())
-    imu_methods = {m for m, spec in config["methods"].items()
-                   if "roll_rate" in make_detector(spec["detector"], spec.get("params")).signals()}
-    assert imu_methods and imu_methods != set(config["methods"])
-    load = failures[failures["stage"] == "load"]
-    assert load["flight"].tolist() == [unreadable] and "empty file" in load["error"].iloc[0]
-    own = failures[failures["stage"] != "load"]
-    assert set(own["flight"]) == {gap} and set(own["method"]) == imu_methods
-    assert (own["file"] == f"{gap}-{IMU}.csv").all()
-    summary = read_table(tmp_path / "results/tables/summary.csv").set_index(["method", "subset"])
-    for method in config["methods"]:
-        row = summary.loc[(method, "all")]
-        # the unreadable flight is excluded everywhere, the gap only where the IMU is read
-        assert row["excluded"] == 1 + (method in imu_methods), method
-        assert row["flights"] + row["excluded"] == 8, method
-    assert "| excluded |" in (tmp_path / "results/tables/summary.md").read_text()
 
 
 def test_strict_mode_stops_at_the_first_broken_flight(broken_corpus, tmp_path):
@@ -599,18 +590,37 @@ def damaged(corpus, overlay, tmp_path_factory):
     path.write_bytes(b"\xef\xbb\xbf" + path.read_bytes())
     os.symlink(root / "gone", processed / "carbonZ_2018-09-11-14-41-51_elevator_failure")
     write_flight(processed, "not_an_alfa_name", onset_s=50.0)
+    # what a user met, one of each on a day: a topic only some runs read going back in
+    # time, a word in a number's cell, an empty cell, a missing topic file; and an
+    # empty file and a gap of seconds
+    back = flight("carbonZ_2018-09-11-14-16-55_no_failure")
+    edit(YAW, lambda ls: ls[:3] + [ls[4], ls[3]] + ls[5:])(back)
+    word = flight("carbonZ_2018-09-11-15-06-34_1_rudder_right_failure", onset_s=45.0,
+                  fault_topic="failure_status-rudder", code=1)
+    edit(WIND, lambda ls: ls[:5] + [set_cell(ls[5], 4, "abc")] + ls[6:])(word)
+    empty = flight("carbonZ_2018-09-11-14-41-38_no_failure")
+    edit(ROLL, lambda ls: ls[:7] + [set_cell(ls[7], 5, "")] + ls[8:])(empty)
+    gone = flight("carbonZ_2018-09-11-17-55-30_1_right_aileron_failure", onset_s=50.0,
+                  fault_topic="failure_status-aileron", code=1)
+    topic_file(gone, ERRORS).unlink()
+    unreadable = flight("carbonZ_2018-09-11-14-22-07_2_no_failure")
+    topic_file(unreadable, ROLL).write_text("")
+    gap = flight("carbonZ_2018-10-05-15-55-10_elevator_failure", onset_s=40.0,
+                 fault_topic="failure_status-elevator")
+    edit(IMU, _gap)(gap)
     work = root / "run"
     work.mkdir()
-    run_workflow(work, processed.parent, "--keep-going", "--configfile",
-                 str(REPO / "config/config.yaml"), str(overlay[0]))
-    refused = {onset_out.name, spike.name, "not_an_alfa_name",
-               "carbonZ_2018-09-11-14-41-51_elevator_failure"}
-    return work, refused | {nan_cell.name, bom.name, late.name}, refused
+    done = run_workflow(work, processed.parent, "--keep-going", "--configfile",
+                        str(REPO / "config/config.yaml"), str(overlay[0]))
+    refused = {onset_out.name, spike.name, "not_an_alfa_name", nan_cell.name, late.name,
+               "carbonZ_2018-09-11-14-41-51_elevator_failure", back.name, word.name,
+               empty.name, gone.name, unreadable.name, gap.name}
+    return work, refused | {bom.name}, refused, done
 
 
 def test_a_corpus_of_every_damage_runs_to_the_end_and_scores_every_clean_flight(damaged,
                                                                                corpus):
-    work, _, refused = damaged
+    work, _, refused, _ = damaged
     config = yaml.safe_load((REPO / "config/config.yaml").read_text())
     clean = {p.name for p in corpus.iterdir()}
     for method in config["methods"]:
@@ -625,18 +635,20 @@ def test_a_corpus_of_every_damage_runs_to_the_end_and_scores_every_clean_flight(
     assert "a broken link" in why["carbonZ_2018-09-11-14-41-51_elevator_failure"]
     assert "not an ALFA flight name" in why["not_an_alfa_name"]
     assert "empty or NaN cell" in why["carbonZ_2018-07-30-16-39-00_3_no_failure"]
-    skipped = read_table(work / "results/injected/skipped.csv")
-    assert "carbonZ_2018-07-30-16-39-00_3_no_failure" in set(skipped["flight"])
+    assert "timestamps go backwards" in why["carbonZ_2018-09-11-14-16-55_no_failure"]
+    assert "non-numeric cell 'abc'" in why["carbonZ_2018-09-11-15-06-34_1_rudder_right_failure"]
+    assert "topic file is missing" in why["carbonZ_2018-09-11-17-55-30_1_right_aileron_failure"]
+    assert "empty file" in why["carbonZ_2018-09-11-14-22-07_2_no_failure"]
+    assert "held longer than 1.0 s" in why["carbonZ_2018-10-05-15-55-10_elevator_failure"]
     recorded = {p.stem for p in (work / "results/rerun").glob("*.rrd")}
     assert clean - {p for p in clean if "no_ground_truth" in p} <= recorded
 
 
 def test_a_damaged_flight_moves_no_clean_flight_but_through_calibration(damaged, runs, corpus):
     """The clean flights' outcomes equal a run without the damaged flights, or differ
-    only where a damaged flight the checks accepted (a repair, a bad column the method
-    does not read) calibrated them, as the record says; a refused flight calibrates
-    nothing."""
-    work, damaged_flights, refused = damaged
+    only where a damaged flight the checks accepted (a repair) calibrated them, as the
+    record says; a refused flight calibrates nothing."""
+    work, damaged_flights, refused, _ = damaged
     config = yaml.safe_load((REPO / "config/config.yaml").read_text())
     for method in config["methods"]:
         for flight in sorted(p.name for p in corpus.iterdir()):
@@ -651,6 +663,50 @@ def test_a_damaged_flight_moves_no_clean_flight_but_through_calibration(damaged,
                 assert used & damaged_flights, (method, flight)
 
 
+def test_every_run_scores_the_same_flights_and_every_output_names_those_left_out(damaged):
+    """A flight any catalogue signal cannot be read on is refused at load, for every run:
+    every run scores the same flights, and the ranking is the common ground's, stated
+    with the same counts on the page, in the comparison and in the paper, naming the
+    flights left out; Snakemake's output ends on a line saying so."""
+    work, _, refused, done = damaged
+    config = yaml.safe_load((REPO / "config/config.yaml").read_text())
+    scored = {m: frozenset(p.stem for p in (work / "results/detections" / m).glob("*.json"))
+              for m in config["methods"]}
+    assert len(set(scored.values())) == 1, scored
+    failures = read_table(work / "results/tables/failures.csv", keep_default_na=False)
+    assert set(failures["stage"]) == {"load"} and set(failures["flight"]) == refused
+    left_out = read_table(work / "results/tables/left_out.csv", keep_default_na=False)
+    assert set(left_out["flight"]) == refused and set(left_out["runs"]) == {"every run"}
+    manifest = read_table(work / "results/flights.csv", keep_default_na=False)
+    summary = read_table(work / "results/tables/summary.csv").set_index(["method", "subset"])
+    comparison = read_table(work / "results/tables/comparison.csv")
+    page = (work / "results/index.html").read_text()
+    paper = (work / "paper/build/paper.md").read_text()
+    for subset in ("all", "no_emr"):
+        labelled = sum(subset in s.split(";") for s in manifest["subsets"])
+        gone = sum(subset in str(s).split(";") for s in left_out["subsets"])
+        for method in config["methods"]:
+            row = summary.loc[(method, subset)]
+            assert (row["flights"], row["excluded"]) == (labelled, gone), (method, subset)
+        rows = comparison[comparison["subset"] == subset]
+        assert rows["rank"].notna().sum() > 3 and (rows["flights"] == labelled).all()
+        said = f"{labelled + gone} flights, {labelled} on the common ground, {gone} left out"
+        assert said in paper and said in (work / "results/tables/comparison.md").read_text()
+        if subset == "no_emr":
+            assert said in page
+    for flight in left_out.loc[left_out["subsets"].str.contains("no_emr"), "flight"]:
+        assert flight in page and flight in paper
+    assert "| excluded |" in (work / "results/tables/summary.md").read_text()
+    # last but Snakemake's own closing lines (the log's path, the time taken)
+    last = [line for line in done.stderr.strip().splitlines()[-3:]
+            if line.startswith("alfa-bench: ")]
+    assert last == [
+        f"alfa-bench: {len(refused)} flight(s) left out of the common ground every run is "
+        f"ranked on: {len(refused)} refused at load, 0 failed by 0 run(s); {len(failures)} "
+        "error(s) in results/tables/failures.csv, the flights in results/tables/left_out.csv"
+    ], done.stderr
+
+
 def test_a_misspelt_signal_in_a_config_run_stops_the_dry_run(corpus, tmp_path):
     """A typo is the config's error: it stops `snakemake -n` naming the run, instead of
     excluding every flight as bad data."""
@@ -661,3 +717,28 @@ def test_a_misspelt_signal_in_a_config_run_stops_the_dry_run(corpus, tmp_path):
     done = run_workflow(tmp_path, corpus.parent, "-n", "--configfile",
                         str(REPO / "config/config.yaml"), str(config), ok=False)
     assert "config methods.typo: unknown signal(s) ['roll_cmdd']" in done.stdout + done.stderr
+
+
+def test_a_run_taken_out_of_the_config_is_named_removable_and_never_compared(runs, corpus,
+                                                                            tmp_path):
+    """A result folder no configured run writes: the dry run names it, `snakemake
+    remove_stale` removes it, and `compare` (given the checkout's root) ranks the
+    published config's runs only."""
+    import alfa_bench as ab
+
+    work = tmp_path / "checkout"
+    shutil.copytree(runs[0] / "results", work / "results",
+                    ignore=shutil.ignore_patterns("rerun*", "figure*", "traces", "cache"))
+    shutil.copytree(work / "results/detections/silent", work / "results/detections/gone_run")
+    result = ab.evaluate("silent", ab.load_corpus(corpus.parent, cache=tmp_path / "cache"),
+                         name="mine")
+    table = ab.compare(result, published=work)
+    assert "mine" in set(table["method"]) and "silent" in set(table["method"])
+    assert "gone_run" not in set(table["method"])
+    config = ["--configfile", str(REPO / "config/config.yaml")]
+    dry = run_workflow(work, corpus.parent, "-n", *config, quiet=False)
+    assert ("no configured run writes any more, e.g. results/detections/gone_run"
+            in dry.stdout + dry.stderr)
+    run_workflow(work, corpus.parent, *config, target="remove_stale")
+    assert not (work / "results/detections/gone_run").exists()
+    assert (work / "results/detections/silent").is_dir()

@@ -2,8 +2,11 @@
 
 import logging
 import sys
+from pathlib import Path
 
-__all__ = ["log_to"]
+import pandas as pd
+
+__all__ = ["failed_flights_line", "log_to"]
 
 
 def log_to(path: str) -> None:
@@ -18,3 +21,22 @@ def log_to(path: str) -> None:
         sys.__excepthook__(kind, value, tb)
 
     sys.excepthook = excepthook
+
+
+def failed_flights_line(results: str | Path = "results") -> str | None:
+    """One line on the flights the run failed on, for the end of Snakemake's log: how
+    many were refused at load and how many some run failed on, and where to read why;
+    None when there are none, or no table says yet."""
+    results = Path(results)
+    left_out, failures = results / "tables/left_out.csv", results / "tables/failures.csv"
+    if not left_out.is_file():
+        return None
+    rows = pd.read_csv(left_out, dtype=str, keep_default_na=False)
+    if not len(rows):
+        return None
+    load = rows["runs"] == "every run"
+    runs = {m for r in rows.loc[~load, "runs"] for m in r.split(";") if m}
+    errors = len(pd.read_csv(failures)) if failures.is_file() else 0
+    return (f"alfa-bench: {len(rows)} flight(s) left out of the common ground every run is "
+            f"ranked on: {int(load.sum())} refused at load, {int((~load).sum())} failed by "
+            f"{len(runs)} run(s); {errors} error(s) in {failures}, the flights in {left_out}")
