@@ -113,3 +113,38 @@ def test_measured_airspeed_is_not_measured_from_2018_09_11_on(manifest):
     dead = manifest["not_measured"].str.split(";").apply(lambda s: "airspeed" in s)
     assert (dead == (manifest["date"] >= "2018-09-11")
             | (manifest["label"] == "no_ground_truth")).all()
+
+
+def test_damaged_real_flights_are_refused_at_load_for_every_run(real_processed, tmp_path):
+    """Four flights of 2018-09-11, copied and damaged one way each (a topic going back in
+    time, a word in a number's cell, an empty cell, a missing topic file), are refused
+    at load, where every run would otherwise have read them differently; an undamaged
+    copy of the same day loads. (The ranking on the flights left, with the workflow, is
+    tests/test_workflow.py's, on the synthetic corpus.)"""
+    import shutil
+
+    from broken import edit, set_cell, topic_file
+
+    from alfa_bench.data import scan_flights
+
+    names = ["carbonZ_2018-09-11-14-16-55_no_failure",
+             "carbonZ_2018-09-11-15-06-34_1_rudder_right_failure",
+             "carbonZ_2018-09-11-14-41-38_no_failure",
+             "carbonZ_2018-09-11-17-55-30_1_right_aileron_failure",
+             "carbonZ_2018-09-11-15-05-11_2_no_failure"]
+    for name in names:
+        shutil.copytree(real_processed / name, tmp_path / "processed" / name)
+    back, word, empty, gone, clean = (tmp_path / "processed" / n for n in names)
+    edit("mavros-nav_info-yaw", lambda ls: ls[:3] + [ls[4], ls[3]] + ls[5:])(back)
+    edit("mavros-wind_estimation", lambda ls: ls[:5] + [set_cell(ls[5], 4, "abc")]
+         + ls[6:])(word)
+    edit("mavros-nav_info-roll", lambda ls: ls[:7] + [set_cell(ls[7], 5, "")] + ls[8:])(empty)
+    topic_file(gone, "mavros-nav_info-errors").unlink()
+    manifest, failures = scan_flights(tmp_path / "processed")
+    assert list(manifest["flight"]) == [clean.name]
+    why = failures.set_index("flight")["error"]
+    assert set(failures["stage"]) == {"load"}
+    assert "timestamps go backwards" in why[back.name]
+    assert "non-numeric cell 'abc'" in why[word.name]
+    assert "empty or NaN cell" in why[empty.name]
+    assert "topic file is missing" in why[gone.name]
