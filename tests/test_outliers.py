@@ -59,3 +59,16 @@ def test_any_model_is_one_line_from_a_notebook(corpus, tmp_path):
                                       window_s=1.0), corpus_)
     assert result.records and not hasattr(mine, "decision_scores_")   # a copy was fitted
     assert {r["family"] for r in result.records} == {"generic outlier"}
+
+
+def test_a_pyod_model_is_found_by_its_class_whatever_its_module():
+    """FeatureBagging lives in pyod.models.feature_bagging, not in a module named for it
+    in lower case; a class PyOD does not define is named as such, with what to do."""
+    from alfa_bench.methods.outliers import pyod_module
+
+    assert pyod_module("FeatureBagging") == "feature_bagging"
+    assert pyod_module("IForest") == "iforest"
+    with pytest.raises(ValueError, match="no module of pyod.models .* defines a class "
+                                         "IsolationTree.*What to do: name a model class"):
+        make_detector("pyod", {"model": "IsolationTree"}).check_params()
+    make_detector("pyod", {"model": "HBOS"}).check_params()

@@ -402,6 +402,8 @@ def test_small_and_one_sided_flight_sets_run_to_the_end(specs, why, tmp_path):
     ("methods: {x: {detector: rls_arx_zscor}}", "config methods.x: \"unknown detector"),
     ("methods: {x: {detector: rls_arx_zscore, params: {zthreshold: 3}}}",
      "config methods.x: detector 'rls_arx_zscore' has no parameter 'zthreshold'"),
+    ("methods: {x: {detector: pyod, params: {model: IsolationTree}}}",
+     "config methods.x: pyod model 'IsolationTree' with params {} cannot be built"),
 ])
 def test_a_wrong_config_value_is_named_before_any_job_runs(corpus, tmp_path, config, message):
     (tmp_path / "bad.yaml").write_text(config + "\n")
