@@ -11,9 +11,10 @@ from broken import IMU, ROLL, edit, set_cell
 from recordings import content
 
 from alfa_bench.analysis import detect_all
-from alfa_bench.data import load_flight, scan_flights
+from alfa_bench.data import AlfaDataError, load_flight, scan_flights
 from alfa_bench.data.inject import InjectedGrid
 from alfa_bench.data.manifest import manifest_of, manifest_row
+from alfa_bench.data.signals import check_signals
 from alfa_bench.data.synthetic import write_flight
 from alfa_bench.methods import make_detector, run_detector
 from alfa_bench.methods.extremes import CAP_LEVEL, gumbel_threshold
@@ -46,10 +47,14 @@ def test_every_entry_of_processed_is_a_flight_or_a_failure_saying_why(tmp_path):
 
 
 def test_a_bad_cell_in_a_fault_free_flight_skips_its_sensor_in_the_grid(tmp_path):
+    """The loader refuses such a flight (check_signals); a grid built from one that did
+    not come through it skips the sensor, saying why."""
     folder = write_flight(tmp_path / "processed", FREE, seed=1)
+    manifest = manifest_of([manifest_row(load_flight(folder))])
     edit(ROLL, lambda ls: ls[:7] + [set_cell(ls[7], 5, "nan")] + ls[8:])(folder)
     flight = load_flight(folder)
-    manifest = manifest_of([manifest_row(flight)])
+    with pytest.raises(AlfaDataError, match="empty or NaN cell"):
+        check_signals(flight)
     grid = InjectedGrid({FREE: flight}, manifest, tmp_path / "grid", ["roll", "pitch_rate"],
                         [{"kind": "stuck", "magnitude": 0.0}], [0.5])
     assert [s["sensor"] for s in grid.skipped] == ["roll"]
