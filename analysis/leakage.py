@@ -67,7 +67,15 @@ import pandas as pd
 from numpy.lib.stride_tricks import sliding_window_view
 from scipy.stats import binom
 
-from alfa_bench.data import SIGNALS, AlfaDataError, Flight, not_measured, series, subset_flights
+from alfa_bench.data import (
+    SIGNALS,
+    AlfaDataError,
+    Flight,
+    in_subset,
+    not_measured,
+    series,
+    subset_flights,
+)
 from alfa_bench.render import fmt, markdown
 
 from .blocks import FAULT_ORDER
@@ -277,8 +285,7 @@ def audit_note(table: pd.DataFrame, manifest: pd.DataFrame, subset: str,
     counted in the subset's size but not audited."""
     flights = subset_flights(manifest, subset)
     bad = leaking_flights(table, manifest, flights)
-    gone = 0 if refused is None else int(refused["subsets"].fillna("").astype(str)
-                                         .str.split(";").apply(lambda s: subset in s).sum())
+    gone = 0 if refused is None else len(in_subset(refused, subset))
     size = (f"{len(flights)} flights" if not gone else
             f"{len(flights) + gone} flights, {gone} refused at load and not audited")
     if not bad:

@@ -24,6 +24,7 @@ from .flight import (
 from .manifest import (
     SUBSETS,
     build_manifest,
+    in_subset,
     name_subsets,
     read_manifest,
     scan_flights,
@@ -45,7 +46,7 @@ __all__ = [
     "FAILURE_COLUMNS", "FAULT_CLASSES", "KINDS", "MAX_HOLD_S", "SIGNALS", "SUBSETS",
     "AlfaDataError", "DownloadError", "Fault", "Flight", "MissingFolderError",
     "MissingTopicError", "Sampled", "Signal", "StaleCacheError", "Topic", "UnknownSignalError",
-    "build_manifest", "failure_row", "fetch_alfa", "find_flights", "load_cached",
+    "build_manifest", "failure_row", "fetch_alfa", "find_flights", "in_subset", "load_cached",
     "load_flight", "name_subsets", "not_measured", "parse_flight_name", "processed_dir",
     "read_manifest", "reads_actuators",
     "read_cached", "resolve_alfa_dir", "sample", "scan_flights", "series", "subset_flights",

@@ -35,7 +35,8 @@ from .errors import FAILURE_COLUMNS, AlfaDataError, failure_row
 from .flight import Flight, entries, find_flights, load_flight, not_a_flight, parse_flight_name
 from .signals import check_signals, not_measured
 
-__all__ = ["ICRA22_LAST_DATE", "SUBSETS", "build_manifest", "flight_sha256", "manifest_of",
+__all__ = ["ICRA22_LAST_DATE", "SUBSETS", "build_manifest", "flight_sha256", "in_subset",
+           "manifest_of",
            "manifest_row", "name_subsets", "read_manifest", "scan_flights", "subset_flights",
            "validate_manifest"]
 
@@ -208,5 +209,11 @@ def subset_flights(manifest: pd.DataFrame, subset: str) -> list[str]:
     """Flights of ``subset``, in manifest order."""
     if subset not in SUBSETS:
         raise KeyError(f"unknown subset {subset!r}; known: {sorted(SUBSETS)}")
-    member = manifest["subsets"].str.split(";").apply(lambda s: subset in s)
-    return manifest.loc[member, "flight"].tolist()
+    return in_subset(manifest, subset)["flight"].tolist()
+
+
+def in_subset(rows: pd.DataFrame, subset: str) -> pd.DataFrame:
+    """The ``rows`` (of the manifest, ``failures.csv`` or ``left_out.csv``) whose
+    ``subsets`` name ``subset``; an empty cell names none."""
+    return rows[rows["subsets"].fillna("").astype(str).str.split(";").apply(
+        lambda s: subset in s)]

@@ -16,9 +16,10 @@ from pathlib import Path
 import pandas as pd
 
 from alfa_bench.analysis.blocks import FAULT_ORDER
+from alfa_bench.data import in_subset
 from alfa_bench.render import fmt
 
-from .tables import SIGNIFICANCE, SILENT, SUBSET_NOTES, ground_note, in_subset
+from .tables import SIGNIFICANCE, SILENT, SUBSET_NOTES, ground_note
 
 __all__ = ["index_html"]
 

@@ -40,13 +40,13 @@ from alfa_bench.analysis.isolation import names_class
 from alfa_bench.analysis.reference import ICRA2019_BY_FAULT, ICRA2019_NAME, ICRA2019_SUMMARY
 from alfa_bench.analysis.scoring import mcnemar_exact, score_records
 from alfa_bench.analysis.stability import pool_summaries, stability_table
-from alfa_bench.data import FAILURE_COLUMNS, subset_flights
+from alfa_bench.data import FAILURE_COLUMNS, in_subset, subset_flights
 from alfa_bench.render import Section, fmt, latex_tables, markdown
 
 __all__ = ["LEFT_OUT_COLUMNS", "SIGNIFICANCE", "SILENT", "by_fault_latex",
            "by_fault_markdown", "by_fault_table", "comparison_latex", "comparison_markdown",
            "common_ground", "comparison_notes", "comparison_table", "configurations",
-           "failures_table", "ground_note", "in_subset", "left_out_markdown",
+           "failures_table", "ground_note", "left_out_markdown",
            "refit_markdown", "stability_markdown", "summary_latex", "summary_markdown",
            "summary_table", "unscored_notes"]
 
@@ -114,40 +114,30 @@ def common_ground(records: list[dict], manifest: pd.DataFrame,
             pd.DataFrame(rows, columns=LEFT_OUT_COLUMNS))
 
 
-def in_subset(rows: pd.DataFrame, subset: str) -> pd.DataFrame:
-    """The ``rows`` (of ``failures.csv`` or ``left_out.csv``) whose ``subsets`` name
-    ``subset``."""
-    return rows[rows["subsets"].fillna("").astype(str).str.split(";").apply(
-        lambda s: subset in s)]
-
-
-def _records_for(records: list[dict], manifest: pd.DataFrame, subset: str,
-                 failures: pd.DataFrame | None = None) -> dict[str, tuple[list[dict], int]]:
-    """method -> (its records of the subset's flights on the common ground
-    (:func:`common_ground`), the flights of the subset it failed on itself); the subset's
-    flights off the common ground are ``excluded`` from every run alike."""
-    records, _ = common_ground(records, manifest, failures)
-    flights = subset_flights(manifest, subset)
+def _on_ground(kept: list[dict], manifest: pd.DataFrame, subsets,
+               failures: pd.DataFrame | None) -> dict[str, dict[str, tuple[list[dict], int, int]]]:
+    """subset -> method -> (its records ``kept`` on the common ground
+    (:func:`common_ground`) of the subset's flights, the flights of the subset it failed
+    on itself, the subset's flights off the common ground: refused at load or not
+    scored by every run, ``excluded`` from every run alike). A subset with no flight
+    scored has no row."""
     f = _failures(failures)
-    member = f[f["flight"].isin(flights) & (f["method"] != "")]
-    failed = member.groupby("method")["flight"].nunique().to_dict()
+    own = f[f["method"] != ""]
     by_method: dict[str, dict[str, dict]] = {}
-    for r in records:
+    for r in kept:
         by_method.setdefault(r["method"], {})[r["flight"]] = r
     out = {}
-    for method, recs in by_method.items():
-        scored = [recs[x] for x in flights if x in recs]
-        if scored:             # a subset with no flight scored has no row to show
-            out[method] = (scored, int(failed.get(method, 0)))
+    for subset in subsets:
+        flights = subset_flights(manifest, subset)
+        failed = own[own["flight"].isin(flights)].groupby("method")["flight"].nunique()
+        refused = len(in_subset(f[f["stage"] == "load"], subset))
+        out[subset] = {}
+        for method, recs in by_method.items():
+            scored = [recs[x] for x in flights if x in recs]
+            if scored:
+                out[subset][method] = (scored, int(failed.get(method, 0)),
+                                       len(flights) - len(scored) + refused)
     return out
-
-
-def _left_out_count(manifest: pd.DataFrame, subset: str, scored: int,
-                    failures: pd.DataFrame | None) -> int:
-    """The subset's flights off the common ground: refused at load, or not scored."""
-    f = _failures(failures)
-    at_load = in_subset(f[f["stage"] == "load"], subset)
-    return len(subset_flights(manifest, subset)) - scored + len(at_load)
 
 
 def _scores(recs: list[dict], deadline_s: float) -> tuple[list[str], dict]:
@@ -161,13 +151,12 @@ def _scores(recs: list[dict], deadline_s: float) -> tuple[list[str], dict]:
 def summary_table(records: list[dict], manifest: pd.DataFrame, subsets, deadline_s: float,
                   failures: pd.DataFrame | None = None) -> pd.DataFrame:
     rows = []
-    for subset in subsets:
-        for method, (recs, failed) in _records_for(records, manifest, subset,
-                                                   failures).items():
+    kept, _ = common_ground(records, manifest, failures)
+    for subset, runs in _on_ground(kept, manifest, subsets, failures).items():
+        for method, (recs, failed, excluded) in runs.items():
             _, s = _scores(recs, deadline_s)
             rows.append({"method": method, "subset": subset, "block": block(recs[0]),
-                         "deadline_s": deadline_s, **s,
-                         "excluded": _left_out_count(manifest, subset, len(recs), failures),
+                         "deadline_s": deadline_s, **s, "excluded": excluded,
                          "failed_flights": failed})
     return pd.DataFrame(rows)
 
@@ -216,13 +205,14 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
     stable detections (survival at least ``stable``), the central ``interval`` of the
     in-time detections over the pools, and ``rank_range``, the ranks a ranked run
     takes over the pools (the other ranked runs re-scored under the same pools)."""
-    pooled = stability_table(common_ground(records, manifest, failures)[0], manifest, subsets,
-                             deadline_s, stable, interval).set_index(["subset", "method"])
+    kept, _ = common_ground(records, manifest, failures)
+    ground = _on_ground(kept, manifest, subsets, failures)
+    pooled = stability_table(kept, manifest, subsets, deadline_s, stable, interval
+                             ).set_index(["subset", "method"])
     rows = []
     for subset in subsets:
         runs = []
-        for method, (recs, failed) in _records_for(records, manifest, subset,
-                                                   failures).items():
+        for method, (recs, failed, excluded) in ground[subset].items():
             outcomes, s = _scores(recs, deadline_s)
             named, hits = _isolation(recs, outcomes)
             free = [r for r in recs if r["fault_class"] == "none"]
@@ -239,7 +229,7 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
                 "armed_flights": sum(any(v is not None for v in r["pair_armed_s"].values())
                                      for r in recs),
                 "isolation": named / hits if hits else math.nan,
-                "excluded": _left_out_count(manifest, subset, len(recs), failures),
+                "excluded": excluded,
                 "failed_flights": failed,
                 **{k: pooled.at[(subset, method), k]
                    for k in ("stable_detections", "detections_low", "detections_high")},
@@ -311,8 +301,9 @@ def by_fault_table(records: list[dict], manifest: pd.DataFrame, subsets, deadlin
                    failures: pd.DataFrame | None = None) -> pd.DataFrame:
     info = manifest.set_index("flight")
     rows = []
-    for subset in subsets:
-        for method, (recs, _) in _records_for(records, manifest, subset, failures).items():
+    kept, _ = common_ground(records, manifest, failures)
+    for subset, runs in _on_ground(kept, manifest, subsets, failures).items():
+        for method, (recs, _, _) in runs.items():
             groups = {c: [r for r in recs if r["fault_class"] == c] for c in FAULT_ORDER}
             groups["total"] = recs
             for fault_class, group in groups.items():
