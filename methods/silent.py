@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from alfa_bench.data import Sampled
+
 from .base import Detector
 
 __all__ = ["Silent"]
@@ -29,3 +31,8 @@ class Silent(Detector):
 
     def update(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:
         return -np.abs(x[:1])
+
+    def run(self, s: Sampled, probes: bool = False, start: int = 0, state: object | None = None
+            ) -> tuple[np.ndarray, dict]:
+        # the batch form: it has no state, so any step continues from any other
+        return -np.abs(s.x[start:, :1]), {}

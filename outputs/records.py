@@ -106,15 +106,12 @@ def read_failures(folders) -> list[pd.DataFrame]:
 
 def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
                      manifest: pd.DataFrame, calibration: dict, *, strict: bool, config: dict,
-                     out: Path, traces: Path, recordings: Path | None = None,
-                     panels: Path | None = None,
+                     out: Path, traces: Path, panels: Path | None = None,
                      injected: tuple[pd.DataFrame, Path] | None = None) -> None:
     """Run :func:`detect_all` and write ``out/<flight>.json``, ``traces/<flight>.npz``
     and ``out/failures.csv`` (the flights excluded, empty when ``strict``, which
-    raises instead), each with its provenance; with ``recordings``, also the method's
-    part of each flight's rerun recording there (:func:`~.rerun_log.write_rerun_part`),
-    and with ``panels`` its panel of each flight's figure there
-    (:class:`~.figures.FlightPanel`, ``<flight>.png``).
+    raises instead), each with its provenance; with ``panels``, also its panel of
+    each flight's figure there (:class:`~.figures.FlightPanel`, ``<flight>.png``).
 
     With ``injected`` (its manifest, and a folder), the injected flights of that
     manifest (in ``flights``) are scored in the same pass, each by the fit of its
@@ -126,10 +123,6 @@ def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
     name.
     """
     extra, folder = injected if injected is not None else (manifest.iloc[:0], None)
-    if recordings is not None:
-        from alfa_bench.outputs.rerun_log import (
-            write_rerun_part,  # rerun: only where parts are written
-        )
     if panels is not None:
         from alfa_bench.outputs.flight_figures import (  # matplotlib: likewise
             FlightPanel,
@@ -137,7 +130,7 @@ def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
         )
         panel = FlightPanel(method)
         flight_s = dict(zip(manifest["flight"], manifest["flight_s"], strict=True))
-    for path in (out, traces, recordings, panels, folder):
+    for path in (out, traces, panels, folder):
         if path is not None:
             path.mkdir(parents=True, exist_ok=True)
     failures = None if strict else []
@@ -154,8 +147,6 @@ def write_detections(method: str, spec: dict, flights: Mapping[str, Flight],
         else:
             write_record(record, out / f"{name}.json")
             write_trace(trace, traces / f"{name}.npz", record["provenance"])
-            if recordings is not None:
-                write_rerun_part(name, method, trace, recordings / f"{name}.rrd")
             if panels is not None:
                 panel.draw(trace, record["onset_s"], record["fault_end_s"],
                            flight_span(record["onset_s"], float(flight_s[name])),

@@ -39,8 +39,7 @@ from alfa_bench.analysis.sweep import ratio
 from alfa_bench.data import SIGNALS, AlfaDataError, Flight, series
 from alfa_bench.methods import Trace
 
-__all__ = ["TIMELINE", "blueprint", "merge_rerun_log", "signal_group", "write_rerun_log",
-           "write_rerun_part"]
+__all__ = ["TIMELINE", "blueprint", "signal_group", "write_rerun_log"]
 
 log = logging.getLogger(__name__)
 
@@ -203,36 +202,3 @@ def write_rerun_log(flight: Flight, traces: dict[str, Trace], signals: list[str]
         return [e for method, tr in traces.items() for e in _alarm_events(method, tr)]
 
     _recording(flight, list(traces), signals, Path(path), provenance, fill)
-
-
-def write_rerun_part(flight_id: str, method: str, trace: Trace, path: str | Path) -> None:
-    """One method's part of the recording of flight ``flight_id``: its entities in
-    ``path`` (a recording of the flight's id, without properties or blueprint) and its
-    alarm events beside it, in ``path`` with suffix ``.events.json``. The detect job
-    of the method writes it; :func:`merge_rerun_log` puts the parts together."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    rec = rr.RecordingStream(_APPLICATION, recording_id=flight_id, send_properties=False)
-    rec.save(path)
-    _method_entities(rec, method, trace)
-    rec.flush()
-    rec.disconnect()
-    path.with_suffix(".events.json").write_text(json.dumps(_alarm_events(method, trace)))
-
-
-def merge_rerun_log(flight: Flight, parts: dict[str, Path], signals: list[str],
-                    path: str | Path, provenance: dict) -> None:
-    """The recording :func:`write_rerun_log` writes, from each method's part
-    (:func:`write_rerun_part`, by method) instead of its trace: the parts' chunks are
-    passed on as they are, without drawing them again."""
-    import rerun.chunk as rc
-
-    def fill(rec):
-        alarms = []
-        for part in parts.values():
-            rec.send_chunks(rc.RrdReader(part).store().stream())
-            alarms += [tuple(e) for e in json.loads(
-                Path(part).with_suffix(".events.json").read_text())]
-        return alarms
-
-    _recording(flight, list(parts), signals, Path(path), provenance, fill)

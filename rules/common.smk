@@ -1,5 +1,6 @@
 import functools
 import os
+import shlex
 import sys
 from pathlib import Path
 
@@ -7,7 +8,9 @@ from snakemake.exceptions import WorkflowError
 from snakemake.logging import logger
 
 from alfa_bench.workflow.preflight import alfa_dir_problem, failure_message, stop
+from alfa_bench.workflow import forkserver
 from alfa_bench.workflow.dependencies import module_sources
+from alfa_bench.workflow.detect_job import SERVER_ENV, write_job_config
 from alfa_bench.workflow.logs import failed_flights_line
 from alfa_bench.workflow.stale import remove, stale_results
 from alfa_bench.workflow.resources import count_flights, job_resources
@@ -101,3 +104,22 @@ config["data_origin"] = (
 
 wildcard_constraints:
     method="|".join(METHODS),
+
+
+# A detect job's command (workflow/detect_job.py): the config, after its overrides, in a
+# file it reads; the run's files as arguments.
+JOB_CONFIG = write_job_config(config)
+DETECT_JOB = (f"{shlex.quote(sys.executable)} -m alfa_bench.workflow.detect_job "
+              f"{{wildcards.method}} --config {shlex.quote(str(JOB_CONFIG))} "
+              "--manifest {input.manifest:q} --cache {input.cache:q} "
+              "--detections {output.detections:q} --traces {output.traces:q} "
+              "--panels {output.panels:q} --benchmark {output.benchmark:q} --log {log:q} "
+              "{params.injected}")
+
+
+# On one machine the detect jobs fork from a server that has loaded the imports and the
+# flights once (workflow/forkserver.py); a cluster's jobs run each in its own process.
+onstart:
+    if workflow.local_exec and any(j.rule.name.startswith("detect")
+                                   for j in workflow.dag.needrun_jobs()):
+        forkserver.start(SERVER_ENV, JOB_CONFIG, "results/logs/detect_server.log")

@@ -1,6 +1,7 @@
 # a failed download, or a folder without a flight that reads, ends the run on what to do:
 # its message last, the details in its log (Snakemake's own lines come before)
 onerror:
+    forkserver.stop(SERVER_ENV)
     if _last := failure_message(ALFA_SOURCE, ALFA_DIR):
         print(f"\n{_last}", file=sys.stderr)
 

@@ -11,26 +11,26 @@ rule detect_reference:
     output:
         detections=directory("results/detections/{method}"),
         traces=directory("results/traces/{method}"),
-        # the method's part of each flight's recording and figure, which rerun_logs
-        # and flight_figures put together
-        recordings=directory("results/rerun_parts/{method}"),
+        # the run's panel of each flight's figure, which flight_figures stacks
         panels=directory("results/figure_parts/{method}"),
+        # the job's own time: a fork of the server's counts from the fork
+        benchmark="results/benchmarks/detect/{method}.tsv",
     params:
+        # what re-runs the job when it changes (the job reads it from the config file);
         # canonical JSON, so that only a changed value (not a reordered key) re-runs it
         spec=lambda w: json.dumps(config["methods"][w.method], sort_keys=True),
         calibration=config["calibration"],
         stability=config["stability"],
         strict=config["strict"],
+        injected="",
     resources:
         **JOB_RESOURCES,
     log:
         "results/logs/detect/{method}.log",
-    benchmark:
-        "results/benchmarks/detect/{method}.tsv"
     wildcard_constraints:
         method="|".join(REFERENCES),
-    script:
-        "../scripts/detect.py"
+    shell:
+        DETECT_JOB
 
 
 # Every other run, on the real flights and on the injected sensor-fault grid in one job
@@ -44,8 +44,8 @@ use rule detect_reference as detect with:
     output:
         detections=directory("results/detections/{method}"),
         traces=directory("results/traces/{method}"),
-        recordings=directory("results/rerun_parts/{method}"),
         panels=directory("results/figure_parts/{method}"),
+        benchmark="results/benchmarks/detect/{method}.tsv",
         injected=directory("results/injected/detections/{method}"),
     params:
         spec=lambda w: json.dumps(config["methods"][w.method], sort_keys=True),
@@ -53,6 +53,8 @@ use rule detect_reference as detect with:
         stability=config["stability"],
         strict=config["strict"],
         injection=config["injection"],
-        processed=INJECTED_PROCESSED,
+        injected=lambda w, input, output: (
+            f"--injected {shlex.quote(input.injected)} --injected-out "
+            f"{shlex.quote(output.injected)} --processed {shlex.quote(INJECTED_PROCESSED)}"),
     wildcard_constraints:
         method="|".join(DETECTORS),

@@ -4,8 +4,7 @@ rule rerun_logs:
     input:
         manifest="results/flights.csv",
         cache="results/cache",
-        # each method's part of every recording, written by its detect job
-        parts=expand("results/rerun_parts/{method}", method=METHODS),
+        traces=expand("results/traces/{method}", method=METHODS),
     output:
         directory("results/rerun"),
     params:

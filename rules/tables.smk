@@ -1,5 +1,6 @@
 # the run ends on one line naming the flights it could not score on, when there are any
 onsuccess:
+    forkserver.stop(SERVER_ENV)
     if _failed := failed_flights_line():
         logger.warning(_failed)
 

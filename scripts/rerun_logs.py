@@ -1,5 +1,4 @@
-"""Snakemake script: one rerun recording per flight, merged from every method's part
-(written by its detect job)."""
+"""Snakemake script: one rerun recording per flight, from every method's traces."""
 
 import json
 import logging
@@ -9,7 +8,8 @@ from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.data import read_cached, read_manifest
 from alfa_bench.data.cache import cache_path
 from alfa_bench.methods import make_detector
-from alfa_bench.outputs.rerun_log import merge_rerun_log
+from alfa_bench.outputs.rerun_log import write_rerun_log
+from alfa_bench.outputs.traces import read_trace
 from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821
@@ -22,8 +22,9 @@ prov = run_provenance(sm.config, manifest)
 sha = dict(zip(manifest["flight"], manifest["sha256"], strict=True))
 out = Path(sm.output[0])
 for flight in manifest.loc[manifest["ground_truth"], "flight"]:
-    # a flight a method excluded has no part of it, and is recorded without it
-    parts = {Path(d).name: p for d in sm.input.parts if (p := Path(d) / f"{flight}.rrd").exists()}
-    merge_rerun_log(read_cached(cache_path(sm.input.cache, flight), sha[flight]), parts,
+    # a flight a method excluded has no trace of it, and is recorded without it
+    traces = {Path(d).name: read_trace(p) for d in sm.input.traces
+              if (p := Path(d) / f"{flight}.npz").exists()}
+    write_rerun_log(read_cached(cache_path(sm.input.cache, flight), sha[flight]), traces,
                     signals, out / f"{flight}.rrd", prov)
     logging.info("%s: written", flight)

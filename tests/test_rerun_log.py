@@ -1,8 +1,5 @@
 """Rerun recordings: read back with rerun's own reader."""
 
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,9 +13,7 @@ from alfa_bench.outputs.provenance import read_provenance
 from alfa_bench.outputs.rerun_log import (
     TIMELINE,
     blueprint,
-    merge_rerun_log,
     write_rerun_log,
-    write_rerun_part,
 )
 
 SIGNALS = ["roll_cmd", "roll", "roll_error", "roll_rate", "servo_aileron_left"]
@@ -103,32 +98,6 @@ def test_the_viewer_opens_paused_on_the_fault_with_the_whole_flight_in_view():
     assert len(plots) == 4 and all("VisibleTimeRanges" in v.properties for v in plots)
     assert sum("engine: carbonZ_x" in str(v.name) for v in views) == 3   # signals, overview
     assert blueprint(["m"], ["attitude"]).time_panel.time_selection is None
-
-
-def test_a_recording_merged_from_method_parts_equals_the_one_written_whole(
-        tmp_path, corpus):
-    """Each detect job writes its method's part; rerun_logs merges them: the merged
-    recording holds the entities, values, events and blueprint of the one written
-    from all traces at once (by our reader and by rerun's own `rrd compare`)."""
-    flight = load_flight(next(p for p in sorted(corpus.iterdir()) if "engine" in p.name))
-    traces = {name: run_detector(make_detector("rls_arx_zscore", {
-        "pairs": [{"name": "roll", "input": "roll_cmd", "output": "roll"}],
-        "z_threshold": z}), flight, probes=True) for name, z in [("low", 2.0), ("high", 4.5)]}
-    assert all(t.alarm_intervals() for t in traces.values())    # events from both parts
-    prov = {"inputs": {"a": "0" * 64}}
-    write_rerun_log(flight, traces, SIGNALS, tmp_path / "whole.rrd", prov)
-    for name, trace in traces.items():
-        write_rerun_part(flight.id, name, trace, tmp_path / "parts" / name / f"{flight.id}.rrd")
-    merge_rerun_log(flight, {n: tmp_path / "parts" / n / f"{flight.id}.rrd" for n in traces},
-                    SIGNALS, tmp_path / "merged.rrd", prov)
-    assert content(tmp_path / "merged.rrd") == content(tmp_path / "whole.rrd")
-    blueprints = [rc.RrdReader(tmp_path / f).blueprints() for f in ("whole.rrd", "merged.rrd")]
-    assert len(blueprints[0]) == len(blueprints[1]) == 1
-    rerun = Path(sys.executable).with_name("rerun")
-    done = subprocess.run([str(rerun), "rrd", "compare", "--unordered",
-                           str(tmp_path / "whole.rrd"), str(tmp_path / "merged.rrd")],
-                          capture_output=True, text=True)
-    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
 
 
 def test_every_signal_has_a_view_of_its_own_unit():

@@ -1,4 +1,5 @@
-"""Runtime of the detector jobs, from Snakemake's ``benchmark:`` files.
+"""Runtime of the detector jobs, from the time each writes (``results/benchmarks/detect/
+<method>.tsv``, in Snakemake's benchmark columns).
 
 One row per method run: wall and CPU seconds of its detect job (loading the flights,
 building the injected ones, fitting every fold, running every flight, writing records

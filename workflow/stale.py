@@ -7,17 +7,21 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-__all__ = ["PER_RUN", "remove", "stale_results"]
+__all__ = ["PER_RUN", "RETIRED", "remove", "stale_results"]
 
 #: where each run writes, ``{run}`` its name
-PER_RUN = ("detections/{run}", "traces/{run}", "rerun_parts/{run}", "figure_parts/{run}",
+PER_RUN = ("detections/{run}", "traces/{run}", "figure_parts/{run}",
            "injected/detections/{run}", "benchmarks/detect/{run}.tsv", "logs/detect/{run}.log")
+#: what earlier versions of the workflow wrote and this one does not: each run's part of
+#: the recordings (``rerun_logs`` writes them from the traces now)
+RETIRED = ("rerun_parts",)
 
 
 def stale_results(results: str | Path, runs) -> list[Path]:
-    """The per-run folders and files under ``results`` of a run not among ``runs``."""
+    """The per-run folders and files under ``results`` of a run not among ``runs``,
+    and the :data:`RETIRED` folders."""
     results, runs = Path(results), set(runs)
-    out = []
+    out = [results / r for r in RETIRED if (results / r).exists()]
     for pattern in PER_RUN:
         parent, name = (results / pattern).parent, Path(pattern).name
         suffix = name.removeprefix("{run}")

@@ -1,0 +1,169 @@
+"""A detect job: one configured run over every flight with ground truth and, for a run
+scored on it, over the injected sensor-fault grid, built in memory from the cached
+fault-free flights; each fold is fitted once, on real flights only. Writes the
+detection records, traces, the run's panel of each flight's figure, the flights it
+had to exclude, and the job's own time (``results/benchmarks/detect/<run>.tsv``).
+
+The rule's command is this module::
+
+    python -m alfa_bench.workflow.detect_job <run> --config <job config> --log <log> ...
+
+It hands its arguments to the workflow's fork server (:mod:`.forkserver`) when one
+answers, so that the imports and the flights are paid once per workflow run, not once
+per job; else it runs the job in its own process. Either way :func:`run` does the
+work, and writes the same files.
+
+This module imports only the standard library at the top: the client of a job that
+the server runs pays for nothing else.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import sys
+import time
+from pathlib import Path
+
+__all__ = ["BENCHMARK_COLUMNS", "SERVER_ENV", "forked", "main", "parse", "prepare", "preload",
+           "run", "write_job_config"]
+
+_START = time.perf_counter()
+#: the environment variable naming the fork server's socket, set by the workflow
+SERVER_ENV = "ALFA_BENCH_DETECT_SERVER"
+#: a job's time, as Snakemake's ``benchmark:`` files name the columns
+BENCHMARK_COLUMNS = ("s", "h:m:s", "max_rss", "cpu_time")
+#: what the server has loaded, by the files it came from: the flights every job shares
+_LOADED: dict[tuple, tuple] = {}
+
+
+def write_job_config(config: dict, path: str | Path = ".snakemake/alfa-bench/config.json"
+                     ) -> Path:
+    """Write the workflow's ``config`` (after its overrides, as every result's
+    provenance records it) where the detect jobs read it. The path stays the same
+    whatever the config, as the jobs' command holds it: a new path would be a changed
+    command, and re-run every job."""
+    path = Path(path)
+    text = json.dumps(config, sort_keys=True, allow_nan=False)
+    if not path.is_file() or path.read_text() != text:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        # each process that parses the workflow writes it: whole, or not at all
+        part = path.with_suffix(f".{os.getpid()}.part")
+        part.write_text(text)
+        part.replace(path)
+    return path
+
+
+def parse(argv: list[str]) -> argparse.Namespace:
+    """The job's arguments (the rule's command line)."""
+    p = argparse.ArgumentParser(prog="python -m alfa_bench.workflow.detect_job")
+    p.add_argument("method")
+    p.add_argument("--config", required=True, help="the workflow's config, as JSON")
+    p.add_argument("--manifest", required=True)
+    p.add_argument("--cache", required=True)
+    p.add_argument("--detections", required=True)
+    p.add_argument("--traces", required=True)
+    p.add_argument("--panels", required=True)
+    p.add_argument("--benchmark", required=True)
+    p.add_argument("--log", required=True)
+    p.add_argument("--injected", help="the injected grid's manifest")
+    p.add_argument("--injected-out", help="where the injected records go")
+    p.add_argument("--processed", help="the injected flights' folder name")
+    return p.parse_args(argv)
+
+
+def preload(config: dict) -> None:
+    """Import what the detect jobs of ``config`` run on: the data layer, the records,
+    each configured run's detector module and library model (PyOD's, river's), and
+    the figure panels. The fork server calls it once; its jobs start from here."""
+    from alfa_bench.data.inject import InjectedGrid  # noqa: F401
+    from alfa_bench.methods import make_detector
+    from alfa_bench.outputs.flight_figures import FlightPanel  # noqa: F401
+    from alfa_bench.outputs.records import write_detections  # noqa: F401
+
+    for spec in config["methods"].values():
+        make_detector(spec["detector"], spec.get("params")).check_params()
+
+
+def prepare(args: argparse.Namespace) -> tuple:
+    """The manifest, the cached flights and, for a run scored on it, the injected grid
+    (and its manifest) of ``args``: read once per process, and checked against each
+    other. The server prepares before it forks, so that its jobs share them."""
+    key = (args.manifest, args.cache, args.injected, args.processed, args.config,
+           *(os.stat(p).st_mtime_ns for p in (args.manifest, args.injected) if p))
+    if key in _LOADED:
+        return _LOADED[key]
+    from collections import ChainMap
+
+    from alfa_bench.data import AlfaDataError, load_cached, read_manifest
+    from alfa_bench.data.inject import InjectedGrid
+
+    config = json.loads(Path(args.config).read_text())
+    manifest = read_manifest(args.manifest)
+    flights = load_cached(args.cache, manifest)
+    on_grid = None
+    if args.injected:
+        grid, on_grid = config["injection"], read_manifest(args.injected)
+        free = manifest.loc[manifest["fault_class"] == "none", "flight"]
+        built = InjectedGrid({name: flights[name] for name in free}, manifest, args.processed,
+                             grid["sensors"], grid["faults"], grid["onsets"])
+        if built.sha256 != dict(zip(on_grid["flight"], on_grid["sha256"], strict=True)):
+            raise AlfaDataError(f"{args.injected} is not the grid the config and the cached "
+                                "flights give: re-run the inject rule")
+        flights = ChainMap(flights, built)       # each injected flight built when scored
+    _LOADED.clear()                              # one workflow's flights at a time
+    _LOADED[key] = config, manifest, flights, on_grid
+    return _LOADED[key]
+
+
+def run(args: argparse.Namespace, started: float = _START) -> None:
+    """The job: score ``args.method`` and write its files, then its time since
+    ``started`` (:func:`time.perf_counter`; by default, this module's import)."""
+    from alfa_bench.outputs.records import write_detections
+    from alfa_bench.workflow.logs import log_to
+
+    log_to(args.log)
+    config, manifest, flights, on_grid = prepare(args)
+    injected = None if on_grid is None else (on_grid, Path(args.injected_out))
+    write_detections(args.method, config["methods"][args.method], flights, manifest,
+                     dict(config["calibration"]), strict=config["strict"], config=config,
+                     out=Path(args.detections), traces=Path(args.traces),
+                     panels=Path(args.panels), injected=injected)
+    _write_benchmark(Path(args.benchmark), time.perf_counter() - started)
+
+
+def forked(argv: list[str]) -> None:
+    """The job of ``argv`` in a child of the fork server, timed from the fork."""
+    run(parse(argv), time.perf_counter())
+
+
+def _write_benchmark(path: Path, wall_s: float) -> None:
+    """The job's wall time from its start (its fork from the server, or its process's
+    start when run alone), its CPU time and peak resident memory, MB, in Snakemake's
+    benchmark columns."""
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    cpu_s = usage.ru_utime + usage.ru_stime
+    hms = time.strftime("%H:%M:%S", time.gmtime(wall_s))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("\t".join(BENCHMARK_COLUMNS) + "\n"
+                    f"{wall_s:.4f}\t{hms}\t{usage.ru_maxrss / 1024:.2f}\t{cpu_s:.4f}\n")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the job on the fork server when one answers, else here; its exit status."""
+    argv = sys.argv[1:] if argv is None else argv
+    server = os.environ.get(SERVER_ENV)
+    if server:
+        from .forkserver import submit
+
+        status = submit(server, argv)
+        if status is not None:
+            return status
+    run(parse(argv))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

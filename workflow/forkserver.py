@@ -1,0 +1,206 @@
+"""The detect jobs' fork server: the imports and the flights loaded once per run of the
+workflow, each job a fork of them.
+
+A detect job started as a process of its own pays 1-2 s before its detector runs: the
+imports (numpy, pandas, scipy, scikit-learn, numba's kernels, the configured library
+models, matplotlib) and the cached flights and manifests. On one machine the workflow
+starts this server before its first job (:func:`start`, from ``onstart``) and names
+its socket in the environment (:data:`~.detect_job.SERVER_ENV`). A detect job's
+command is then a client (:func:`submit`): it sends the server its arguments and its
+standard output and error, and waits. The server loads what the job reads, if not yet
+loaded (:func:`~.detect_job.prepare`), and forks; the child, sharing the loaded modules
+and flights copy-on-write, runs the job as it would run alone
+(:func:`~.detect_job.forked`), writes its output to the client's streams, and sends
+its exit status back, which becomes the client's. A client killed by Snakemake takes
+its child with it.
+
+Where no server answers (a cluster executor, which starts none; a server gone), the
+client runs the job in its own process: the same function, the same files.
+
+The server stops with the Snakemake process that started it (:func:`stop`, from
+``onsuccess`` and ``onerror``, else when that process is gone).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import traceback
+from pathlib import Path
+
+__all__ = ["serve", "start", "stop", "submit"]
+
+_STARTED, _EXITED = b"+", b"="
+#: the threads of the numerical libraries, fixed when they load: one, as Snakemake
+#: sets them for a job of one thread (a detect job's)
+_ONE_THREAD = dict.fromkeys(["OMP_NUM_THREADS", "GOTO_NUM_THREADS", "OPENBLAS_NUM_THREADS",
+                             "MKL_NUM_THREADS", "VECLIB_MAXIMUM_THREADS",
+                             "NUMEXPR_NUM_THREADS"], "1")
+#: the servers this process started, by socket path
+_SERVERS: dict[str, subprocess.Popen] = {}
+
+
+def submit(path: str, argv: list[str]) -> int | None:
+    """Run the job of ``argv`` on the server at ``path``, with this process's standard
+    output and error: its exit status, or None when no server took it (the caller
+    runs it itself)."""
+    try:
+        client = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        client.connect(path)
+    except OSError:
+        return None
+    with client:
+        data = json.dumps(argv).encode()
+        socket.send_fds(client, [len(data).to_bytes(4, "big") + data],
+                        [sys.stdout.fileno(), sys.stderr.fileno()])
+        reply = b""
+        while chunk := client.recv(64):
+            reply += chunk
+    if not reply.startswith(_STARTED):
+        return None                  # the server went before it forked: nothing ran
+    if _EXITED not in reply:
+        print(f"alfa-bench: the detect job's process (forked by the server at {path}) "
+              "ended without an exit status; see the job's log", file=sys.stderr)
+        return 1
+    return int(reply.split(_EXITED, 1)[1])
+
+
+def _receive(conn: socket.socket) -> tuple[list[str], list[int]]:
+    """A client's arguments and its output and error streams."""
+    data, fds, _, _ = socket.recv_fds(conn, 65536, 2)
+    size = int.from_bytes(data[:4], "big")
+    data = data[4:]
+    while len(data) < size:
+        more = conn.recv(size - len(data))
+        if not more:
+            raise ConnectionError("the client closed before sending its arguments")
+        data += more
+    return json.loads(data), fds
+
+
+def _child(conn: socket.socket, argv: list[str], fds: list[int], handle) -> None:
+    """In the fork: the client's streams as this process's, the job, its status."""
+    signal.signal(signal.SIGCHLD, signal.SIG_DFL)    # the job's own subprocesses
+    os.dup2(fds[0], 1)
+    os.dup2(fds[1], 2)
+    for fd in fds:
+        os.close(fd)
+    conn.sendall(_STARTED)
+
+    def watch():                     # the client gone (Snakemake killed the job): stop
+        if not conn.recv(1):
+            os._exit(1)
+
+    threading.Thread(target=watch, daemon=True).start()
+    status = 0
+    try:
+        handle(argv)
+    except SystemExit as e:          # argparse's usage error, and sys.exit in a job
+        status = e.code if isinstance(e.code, int) else 1
+    except BaseException:
+        sys.excepthook(*sys.exc_info())      # the job's log gets it, as when run alone
+        status = 1
+    finally:
+        import logging
+
+        logging.shutdown()
+        sys.stdout.flush()
+        sys.stderr.flush()
+        try:
+            conn.sendall(_EXITED + str(status).encode())
+        finally:
+            os._exit(status)
+
+
+def serve(path: str, preload, prepare, handle, parent: int) -> None:
+    """Serve jobs on the Unix socket ``path`` until process ``parent`` is gone:
+    ``preload()`` once, then for each client ``prepare(argv)`` here (what the jobs
+    share; a failure is left for the job to meet), and ``handle(argv)`` in a fork, with
+    the client's streams. It listens before it preloads, so that a job never finds the
+    socket missing: the first jobs wait for the preload instead."""
+    listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    listener.bind(path)
+    listener.listen(64)
+    listener.settimeout(1.0)
+    signal.signal(signal.SIGCHLD, signal.SIG_IGN)    # the kernel reaps the forks
+    try:
+        preload()
+        while os.getppid() == parent and os.path.exists(path):
+            try:
+                conn, _ = listener.accept()
+            except TimeoutError:
+                continue
+            with conn:
+                conn.settimeout(None)
+                try:
+                    argv, fds = _receive(conn)
+                except (OSError, ValueError) as e:
+                    print(f"a client's request could not be read: {e}", file=sys.stderr)
+                    continue
+                try:
+                    prepare(argv)
+                except Exception:
+                    traceback.print_exc()    # the job meets it again, in its own log
+                if os.fork() == 0:
+                    listener.close()
+                    _child(conn, argv, fds, handle)
+                for fd in fds:
+                    os.close(fd)
+    finally:
+        listener.close()
+        Path(path).unlink(missing_ok=True)
+
+
+def start(env: str, config_file: str | Path, log: str | Path, wait_s: float = 10.0) -> str:
+    """Start a server for the jobs of ``config_file`` (its output to ``log``), and
+    name its socket in this process's environment variable ``env``, which the jobs
+    inherit. Returns the socket's path once the server listens on it."""
+    path = os.path.join(tempfile.mkdtemp(prefix="alfa-bench-"), "detect.sock")
+    Path(log).parent.mkdir(parents=True, exist_ok=True)
+    with open(log, "w") as out:
+        _SERVERS[path] = subprocess.Popen(
+            [sys.executable, "-m", "alfa_bench.workflow.forkserver", path, str(config_file),
+             str(os.getpid())], stdout=out, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+            env={**os.environ, **_ONE_THREAD})
+    deadline = time.monotonic() + wait_s
+    while not os.path.exists(path) and time.monotonic() < deadline:
+        if _SERVERS[path].poll() is not None:
+            break
+        time.sleep(0.02)
+    if os.path.exists(path):
+        os.environ[env] = path
+    return path
+
+
+def stop(env: str) -> None:
+    """Stop the servers this process started, and forget ``env``."""
+    os.environ.pop(env, None)
+    for path, server in list(_SERVERS.items()):
+        server.terminate()
+        server.wait()
+        Path(path).unlink(missing_ok=True)
+        Path(path).parent.rmdir()
+        del _SERVERS[path]
+
+
+def _main(path: str, config_file: str, parent: str) -> None:
+    from . import detect_job
+
+    def preload():
+        detect_job.preload(json.loads(Path(config_file).read_text()))
+
+    def prepare(argv):
+        detect_job.prepare(detect_job.parse(argv))
+
+    serve(path, preload, prepare, detect_job.forked, int(parent))
+
+
+if __name__ == "__main__":
+    _main(*sys.argv[1:])
