@@ -34,13 +34,13 @@ SUBSETS = [PRIMARY, *(s for s in config["subsets"] if s != PRIMARY)]
 INJECTED_PROCESSED = "results/injected/processed"
 
 # the schema checks the config's shape; each method's detector and parameter names are
-# checked against the registry here, before any job runs
-for _name, _spec in config["methods"].items():
+# checked against the registry here, before any job runs, by the process that plans the
+# run: a cluster job's process, which parses the workflow again, imports no detector
+for _name, _spec in config["methods"].items() if workflow.is_main_process else ():
     try:
         _detector = make_detector(_spec["detector"], _spec.get("params"))
-        # a library's model by name, imported: once, here, not in every job
-        if workflow.is_main_process:
-            _detector.check_params()
+        # a library's model by name, imported
+        _detector.check_params()
     except (KeyError, TypeError, ValueError) as _e:
         raise WorkflowError(f"config methods.{_name}: {_e}") from None
     # a misspelt signal is the config's error, not every flight's bad data

@@ -26,6 +26,13 @@ def pytest_report_header(config):
             "flights are SKIPPED ***")
 
 
+def pytest_collection_modifyitems(items):
+    # the contract of each config run: the registry's checks again, with its parameters
+    for item in items:
+        if "[config:" in item.nodeid:
+            item.add_marker(pytest.mark.slow)
+
+
 @pytest.fixture(scope="session")
 def real_processed() -> Path:
     if not (REAL_ALFA and (REAL_ALFA / "processed").is_dir()):

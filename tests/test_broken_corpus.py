@@ -116,6 +116,7 @@ def apply(folder, draw) -> str:
 @settings(max_examples=150, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(draws=st.lists(corruption(), min_size=1, max_size=3))
+@pytest.mark.slow
 def test_random_corruptions_never_give_an_unexplained_result(draws, clean, tmp_path_factory,
                                                               caplog):
     """Every run ends in a named error, a logged exclusion, a logged repair, or exactly

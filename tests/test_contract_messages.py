@@ -79,6 +79,7 @@ BROKEN = [Misspelt(), ReturnsNone(), KeepsState(), NoThreshold(), TwoScores(), U
           Drifting(), Blind()]
 
 
+@pytest.mark.slow
 def test_every_failing_check_names_itself_what_it_expected_and_what_to_do():
     failed = set()
     for detector in BROKEN:

@@ -89,6 +89,7 @@ def assert_held_out(records, seen, manifest, group_by="date"):
         assert set(r["calibration"]["flights"]) == fits[fold]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("run", CALIBRATED)
 def test_no_fit_of_a_configured_run_sees_the_group_it_scores(run, corpus_flights,
                                                              corpus_manifest, monkeypatch):

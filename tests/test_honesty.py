@@ -48,6 +48,7 @@ def assert_marked_if_reading_actuators(detector, seen) -> None:
         f"marked reads_actuators={reads_actuators(detector.signals())}")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("run", sorted(RUNS))
 def test_a_run_is_marked_exactly_when_it_reads_an_actuator_column(run, corpus, monkeypatch):
     spec = RUNS[run]

@@ -26,6 +26,7 @@ def test_the_welcome_screen_is_not_taken_for_a_recording():
     assert not check_screenshot(white).shows_recording
 
 
+@pytest.mark.slow
 def test_the_recording_renders_open_on_the_fault(corpus, tmp_path):
     flight = load_flight(next(p for p in sorted(corpus.iterdir()) if "engine" in p.name))
     detector = make_detector("rls_arx_zscore", {"pairs": [
