@@ -181,9 +181,11 @@ class _FoldRunner:
         self.fitted: dict[str, Detector] = {}
         self.forks: dict[str, dict[float, Fork]] = {}
         # the flights the current fold scores, and the scores continued from a source's
-        # forks for those injected into it (continue_forks), until recorded
+        # forks for those injected into it (continue_forks) and those flights, built
+        # once for both (an injected flight is built when looked up), until recorded
         self.scored: list[str] = []
         self.continued: dict = {}
+        self.built: dict[str, Flight] = {}
         # the fold's pool thresholds (pools, channels), or None
         self.pools: np.ndarray | None = None
 
@@ -212,11 +214,15 @@ class _FoldRunner:
                 self.detector, self.flights[source], onsets)) or {}
             # the fold's flights injected into this source, scored in one call
             injected = [n for n in self.scored if self.sources.get(n, ("",))[0] == source]
-            built = [self.guarded("detect", n, lambda n=n: self.flights[n]) for n in injected]
-            self.continued = continue_forks(self.detector, [f for f in built if f is not None],
+            self.built = {n: f for n in injected
+                          if (f := self.guarded("detect", n, lambda n=n: self.flights[n]))
+                          is not None}
+            self.continued = continue_forks(self.detector, list(self.built.values()),
                                             self.forks[source])
+        built = self.built.pop(name, None)
         return self.guarded("detect", name, lambda: detection_record(
-            self.method, self.spec, self.detector, self.flights[name], self.sha, info,
+            self.method, self.spec, self.detector,
+            self.flights[name] if built is None else built, self.sha, info,
             forked=self.forks[source], continued=self.continued.pop(name, None)))
 
     def uncalibrated(self, names: list[str], error: CalibrationError) -> None:
@@ -246,7 +252,7 @@ class _FoldRunner:
         data = [s for f in used for s in segments[f]]
         check_held_out(data, fold, scored, group)
         self.forks = {}                # run by the previous fold's fit
-        self.scored, self.continued = scored, {}
+        self.scored, self.continued, self.built = scored, {}, {}
         self.pools = None
         try:
             detector.fit(data)

@@ -80,11 +80,12 @@ def preload(config: dict) -> None:
     the figure panels. The fork server calls it once; its jobs start from here."""
     from alfa_bench.data.inject import InjectedGrid  # noqa: F401
     from alfa_bench.methods import make_detector
-    from alfa_bench.outputs.flight_figures import FlightPanel  # noqa: F401
+    from alfa_bench.outputs.flight_figures import FlightPanel
     from alfa_bench.outputs.records import write_detections  # noqa: F401
 
     for spec in config["methods"].values():
         make_detector(spec["detector"], spec.get("params")).check_params()
+    FlightPanel("")                 # matplotlib's fonts and text metrics, loaded
 
 
 def prepare(args: argparse.Namespace) -> tuple:
