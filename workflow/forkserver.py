@@ -51,10 +51,11 @@ def submit(path: str, argv: list[str]) -> int | None:
     """Run the job of ``argv`` on the server at ``path``, with this process's standard
     output and error: its exit status, or None when no server took it (the caller
     runs it itself)."""
+    client = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
     try:
-        client = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
         client.connect(path)
     except OSError:
+        client.close()
         return None
     with client:
         data = json.dumps(argv).encode()
