@@ -106,12 +106,11 @@ wildcard_constraints:
     method="|".join(METHODS),
 
 
-# A detect job's command (workflow/detect_job.py): the config, after its overrides, in a
-# file it reads; the run's files as arguments.
+# A detect job's command (workflow/detect_job.py): the run's files as arguments; the
+# config, after its overrides, in a file named in the environment the jobs inherit
 JOB_CONFIG = write_job_config(config)
 DETECT_JOB = (f"{shlex.quote(sys.executable)} -m alfa_bench.workflow.detect_job "
-              f"{{wildcards.method}} --config {shlex.quote(str(JOB_CONFIG))} "
-              "--manifest {input.manifest:q} --cache {input.cache:q} "
+              "{wildcards.method} --manifest {input.manifest:q} --cache {input.cache:q} "
               "--detections {output.detections:q} --traces {output.traces:q} "
               "--panels {output.panels:q} --benchmark {output.benchmark:q} --log {log:q} "
               "{params.injected}")

@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from alfa_bench.workflow import forkserver
-from alfa_bench.workflow.detect_job import SERVER_ENV
+from alfa_bench.workflow.detect_job import CONFIG_ENV, SERVER_ENV, write_job_config
 
 TESTS = Path(__file__).resolve().parent
 _CLIENT = ("import sys; from alfa_bench.workflow.forkserver import submit; "
@@ -143,3 +143,16 @@ def test_started_and_stopped_by_the_workflow_with_one_thread_per_job(tmp_path):
         forkserver.stop(env)
     assert env not in os.environ and not os.path.exists(path)
     assert server.poll() is not None
+
+
+def test_two_configs_never_share_the_file_their_jobs_read(tmp_path, monkeypatch):
+    """A dry run of another config beside a run writes a file of its own: the running
+    jobs still read theirs; the file's name is not in the jobs' command, so a config
+    change re-runs only the jobs whose parameters changed."""
+    monkeypatch.delenv(CONFIG_ENV, raising=False)
+    first = write_job_config({"methods": {"a": {}}}, tmp_path)
+    assert os.environ[CONFIG_ENV] == str(first.resolve())
+    second = write_job_config({"methods": {"b": {}}}, tmp_path)
+    assert second != first and os.environ[CONFIG_ENV] == str(second.resolve())
+    assert json.loads(first.read_text()) == {"methods": {"a": {}}}
+    assert write_job_config({"methods": {"a": {}}}, tmp_path) == first

@@ -6,7 +6,7 @@ had to exclude, and the job's own time (``results/benchmarks/detect/<run>.tsv``)
 
 The rule's command is this module::
 
-    python -m alfa_bench.workflow.detect_job <run> --config <job config> --log <log> ...
+    python -m alfa_bench.workflow.detect_job <run> --manifest <manifest> --log <log> ...
 
 It hands its arguments to the workflow's fork server (:mod:`.forkserver`) when one
 answers, so that the imports and the flights are paid once per workflow run, not once
@@ -20,6 +20,7 @@ the server runs pays for nothing else.
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import os
 import resource
@@ -27,32 +28,36 @@ import sys
 import time
 from pathlib import Path
 
-__all__ = ["BENCHMARK_COLUMNS", "SERVER_ENV", "forked", "main", "parse", "prepare", "preload",
-           "run", "write_job_config"]
+__all__ = ["BENCHMARK_COLUMNS", "CONFIG_ENV", "SERVER_ENV", "forked", "main", "parse",
+           "prepare", "preload", "run", "write_job_config"]
 
 _START = time.perf_counter()
 #: the environment variable naming the fork server's socket, set by the workflow
 SERVER_ENV = "ALFA_BENCH_DETECT_SERVER"
+#: the environment variable naming the workflow's config file (:func:`write_job_config`)
+CONFIG_ENV = "ALFA_BENCH_JOB_CONFIG"
 #: a job's time, as Snakemake's ``benchmark:`` files name the columns
 BENCHMARK_COLUMNS = ("s", "h:m:s", "max_rss", "cpu_time")
 #: what the server has loaded, by the files it came from: the flights every job shares
 _LOADED: dict[tuple, tuple] = {}
 
 
-def write_job_config(config: dict, path: str | Path = ".snakemake/alfa-bench/config.json"
-                     ) -> Path:
+def write_job_config(config: dict, folder: str | Path = ".snakemake/alfa-bench") -> Path:
     """Write the workflow's ``config`` (after its overrides, as every result's
-    provenance records it) where the detect jobs read it. The path stays the same
-    whatever the config, as the jobs' command holds it: a new path would be a changed
-    command, and re-run every job."""
-    path = Path(path)
+    provenance records it) where this process's detect jobs read it, and name the file
+    in :data:`CONFIG_ENV`, which they inherit. The file is named for its content, so
+    that two runs of other configs (a dry run beside a run) never read each other's;
+    the jobs' command does not hold the name, so a config changed elsewhere re-runs no
+    job that does not read the change."""
     text = json.dumps(config, sort_keys=True, allow_nan=False)
-    if not path.is_file() or path.read_text() != text:
+    path = Path(folder) / f"config-{hashlib.sha256(text.encode()).hexdigest()[:16]}.json"
+    if not path.is_file():
         path.parent.mkdir(parents=True, exist_ok=True)
         # each process that parses the workflow writes it: whole, or not at all
         part = path.with_suffix(f".{os.getpid()}.part")
         part.write_text(text)
         part.replace(path)
+    os.environ[CONFIG_ENV] = str(path.resolve())
     return path
 
 
@@ -60,7 +65,8 @@ def parse(argv: list[str]) -> argparse.Namespace:
     """The job's arguments (the rule's command line)."""
     p = argparse.ArgumentParser(prog="python -m alfa_bench.workflow.detect_job")
     p.add_argument("method")
-    p.add_argument("--config", required=True, help="the workflow's config, as JSON")
+    p.add_argument("--config", default=os.environ.get(CONFIG_ENV),
+                   help=f"the workflow's config, as JSON (default: ${CONFIG_ENV})")
     p.add_argument("--manifest", required=True)
     p.add_argument("--cache", required=True)
     p.add_argument("--detections", required=True)
@@ -71,7 +77,10 @@ def parse(argv: list[str]) -> argparse.Namespace:
     p.add_argument("--injected", help="the injected grid's manifest")
     p.add_argument("--injected-out", help="where the injected records go")
     p.add_argument("--processed", help="the injected flights' folder name")
-    return p.parse_args(argv)
+    args = p.parse_args(argv)
+    if args.config is None:
+        p.error(f"the workflow's config: give --config, or set {CONFIG_ENV}")
+    return args
 
 
 def preload(config: dict) -> None:
@@ -155,6 +164,8 @@ def _write_benchmark(path: Path, wall_s: float) -> None:
 def main(argv: list[str] | None = None) -> int:
     """Run the job on the fork server when one answers, else here; its exit status."""
     argv = sys.argv[1:] if argv is None else argv
+    if "--config" not in argv and os.environ.get(CONFIG_ENV):
+        argv = [*argv, "--config", os.environ[CONFIG_ENV]]    # this workflow's, to the server
     server = os.environ.get(SERVER_ENV)
     if server:
         from .forkserver import submit
