@@ -20,6 +20,7 @@ def prepare(argv):
     if argv[0] == "bad-prepare":
         raise RuntimeError("prepare failed")
     prepared.append(argv[0])
+    return argv[0] != "refused"
 
 
 def handle(argv):

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from alfa_bench.workflow import forkserver
+from alfa_bench.workflow import detect_job, forkserver
 from alfa_bench.workflow.detect_job import CONFIG_ENV, SERVER_ENV, write_job_config
 
 TESTS = Path(__file__).resolve().parent
@@ -72,6 +72,23 @@ def test_a_failed_job_fails_its_client_with_the_traceback(server):
 def test_a_job_that_failed_to_prepare_still_runs_and_fails_in_its_own_right(server):
     done = client(server, "bad-prepare")
     assert done.returncode == 1 and "ValueError: the job failed" in done.stderr
+
+
+def test_a_job_the_server_does_not_take_runs_in_its_client(server, tmp_path):
+    """From another folder (another workflow's job) or refused by `prepare` (its
+    code changed since the server loaded it), a job is handed back untouched."""
+    assert client(server, "refused").returncode == 99
+    assert client(server, "echo", cwd=tmp_path).returncode == 99
+    assert client(server, "echo").returncode == 0
+
+
+def test_a_module_changed_after_the_preload_is_seen(monkeypatch, tmp_path):
+    module = tmp_path / "m.py"
+    module.write_text("")
+    monkeypatch.setattr(detect_job, "_SOURCES", {str(module): module.stat().st_mtime_ns})
+    assert not detect_job.code_changed()
+    os.utime(module, ns=(0, module.stat().st_mtime_ns + 1))
+    assert detect_job.code_changed()
 
 
 def test_a_jobs_exit_status_is_its_clients(server):

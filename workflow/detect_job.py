@@ -28,8 +28,8 @@ import sys
 import time
 from pathlib import Path
 
-__all__ = ["BENCHMARK_COLUMNS", "CONFIG_ENV", "SERVER_ENV", "forked", "main", "parse",
-           "prepare", "preload", "run", "write_job_config"]
+__all__ = ["BENCHMARK_COLUMNS", "CONFIG_ENV", "SERVER_ENV", "code_changed", "forked", "main",
+           "parse", "prepare", "preload", "run", "write_job_config"]
 
 _START = time.perf_counter()
 #: the environment variable naming the fork server's socket, set by the workflow
@@ -40,6 +40,8 @@ CONFIG_ENV = "ALFA_BENCH_JOB_CONFIG"
 BENCHMARK_COLUMNS = ("s", "h:m:s", "max_rss", "cpu_time")
 #: what the server has loaded, by the files it came from: the flights every job shares
 _LOADED: dict[tuple, tuple] = {}
+#: the source files of the project's modules the server imported, and their times
+_SOURCES: dict[str, int] = {}
 
 
 def write_job_config(config: dict, folder: str | Path = ".snakemake/alfa-bench") -> Path:
@@ -95,6 +97,28 @@ def preload(config: dict) -> None:
     for spec in config["methods"].values():
         make_detector(spec["detector"], spec.get("params")).check_params()
     FlightPanel("")                 # matplotlib's fonts and text metrics, loaded
+    _SOURCES.update(_source_times())
+
+
+def _source_times() -> dict[str, int]:
+    """The modification time of each imported module of the project, by file."""
+    times = {}
+    for name, module in list(sys.modules.items()):
+        path = getattr(module, "__file__", None)
+        if name.startswith("alfa_bench") and path:
+            try:
+                times[path] = os.stat(path).st_mtime_ns
+            except OSError:
+                times[path] = -1
+    return times
+
+
+def code_changed() -> bool:
+    """Whether a module of the project imported by :func:`preload` changed since: a
+    job forked now would run the old code, and its outputs, newer than the change,
+    would never be re-run."""
+    return any(os.stat(p).st_mtime_ns != t if os.path.exists(p) else True
+               for p, t in _SOURCES.items())
 
 
 def prepare(args: argparse.Namespace) -> tuple:

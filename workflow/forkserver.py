@@ -58,7 +58,7 @@ def submit(path: str, argv: list[str]) -> int | None:
         client.close()
         return None
     with client:
-        data = json.dumps(argv).encode()
+        data = json.dumps({"cwd": os.getcwd(), "argv": argv}).encode()
         socket.send_fds(client, [len(data).to_bytes(4, "big") + data],
                         [sys.stdout.fileno(), sys.stderr.fileno()])
         reply = b""
@@ -73,8 +73,8 @@ def submit(path: str, argv: list[str]) -> int | None:
     return int(reply.split(_EXITED, 1)[1])
 
 
-def _receive(conn: socket.socket) -> tuple[list[str], list[int]]:
-    """A client's arguments and its output and error streams."""
+def _receive(conn: socket.socket) -> tuple[str, list[str], list[int]]:
+    """A client's working folder, arguments, and output and error streams."""
     data, fds, _, _ = socket.recv_fds(conn, 65536, 2)
     size = int.from_bytes(data[:4], "big")
     data = data[4:]
@@ -83,7 +83,8 @@ def _receive(conn: socket.socket) -> tuple[list[str], list[int]]:
         if not more:
             raise ConnectionError("the client closed before sending its arguments")
         data += more
-    return json.loads(data), fds
+    request = json.loads(data)
+    return request["cwd"], request["argv"], fds
 
 
 def _child(conn: socket.socket, argv: list[str], fds: list[int], handle) -> None:
@@ -124,7 +125,10 @@ def serve(path: str, preload, prepare, handle, parent: int) -> None:
     """Serve jobs on the Unix socket ``path`` until process ``parent`` is gone:
     ``preload()`` once, then for each client ``prepare(argv)`` here (what the jobs
     share; a failure is left for the job to meet), and ``handle(argv)`` in a fork, with
-    the client's streams. It listens before it preloads, so that a job never finds the
+    the client's streams. A client is left to run its job itself (nothing is sent to
+    it) when it works in another folder than the server's (another workflow's job), or
+    when ``prepare`` returns False (the server's code is no longer the job's). It
+    listens before it preloads, so that a job never finds the
     socket missing: the first jobs wait for the preload instead."""
     listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
     listener.bind(path)
@@ -141,14 +145,19 @@ def serve(path: str, preload, prepare, handle, parent: int) -> None:
             with conn:
                 conn.settimeout(None)
                 try:
-                    argv, fds = _receive(conn)
-                except (OSError, ValueError) as e:
+                    cwd, argv, fds = _receive(conn)
+                except (OSError, ValueError, KeyError) as e:
                     print(f"a client's request could not be read: {e}", file=sys.stderr)
                     continue
                 try:
-                    prepare(argv)
+                    taken = cwd == os.getcwd() and prepare(argv) is not False
                 except Exception:
                     traceback.print_exc()    # the job meets it again, in its own log
+                    taken = True
+                if not taken:
+                    for fd in fds:
+                        os.close(fd)
+                    continue
                 if os.fork() == 0:
                     listener.close()
                     _child(conn, argv, fds, handle)
@@ -198,7 +207,12 @@ def _main(path: str, config_file: str, parent: str) -> None:
         detect_job.preload(json.loads(Path(config_file).read_text()))
 
     def prepare(argv):
+        if detect_job.code_changed():
+            print("a module changed since the server loaded it: jobs run on their own",
+                  file=sys.stderr)
+            return False
         detect_job.prepare(detect_job.parse(argv))
+        return True
 
     serve(path, preload, prepare, detect_job.forked, int(parent))
 
