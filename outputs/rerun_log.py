@@ -11,10 +11,13 @@ Entities
 ``signals/<group>/<signal>``
     The raw input/output signals of every method, at their topics' record times
     (groups: attitude, attitude_error, rates, servos, airspeed).
-``methods/<method>/scores/<channel>/{score,threshold}``
-    Each channel's score and its threshold.
-``methods/<method>/probes/<probe>``
+``methods/<method>/scores/<k>``, ``methods/<method>/scores/threshold``
+    The channels' scores, and their thresholds.
+``methods/<method>/probes/<k>``
     The method's intermediates: prediction, residual (innovation), parameter change.
+    Series defined at the same steps share one entity ``<k>`` (0, 1, ...), a scalar
+    each, named in the legend: a row then stores its time and row id once for all of
+    them, which halves the recording.
 ``overview/<method>``
     :math:`\\max_c s_c/\\gamma_c`: above 1 the method alarms.
 ``events``
@@ -112,6 +115,24 @@ def _series(rec: rr.RecordingStream, path: str, t: np.ndarray, v: np.ndarray, na
                      columns=rr.Scalars.columns(scalars=v[keep]))
 
 
+def _series_sets(rec: rr.RecordingStream, base: str, t: np.ndarray, names: list[str],
+                 values: np.ndarray) -> None:
+    """The series ``values[i]`` named ``names[i]`` at ``base/<k>``: series finite at the
+    same steps share entity ``k``, so every row holds only finite values, as a series
+    logged alone does."""
+    sets: dict[bytes, list[int]] = {}
+    for i, v in enumerate(values):
+        finite = np.isfinite(v)
+        if finite.any():
+            sets.setdefault(finite.tobytes(), []).append(i)
+    for k, members in enumerate(sets.values()):
+        keep = np.isfinite(values[members[0]])
+        rec.log(f"{base}/{k}", rr.SeriesLines(names=[names[i] for i in members]),
+                static=True)
+        rec.send_columns(f"{base}/{k}", indexes=[rr.TimeColumn(TIMELINE, duration=t[keep])],
+                         columns=rr.Scalars.columns(scalars=values[members][:, keep].T))
+
+
 def _alarm_events(method: str, tr: Trace) -> list[tuple[float, str, str]]:
     events = []
     for i, (start, stop) in enumerate(tr.alarm_intervals()):
@@ -133,12 +154,19 @@ def _fault_events(flight: Flight) -> list[tuple[float, str, str]]:
 def _method_entities(rec: rr.RecordingStream, method: str, tr: Trace) -> None:
     """A method's entities: its scores, thresholds, probes and overview line."""
     base = f"methods/{method}"
-    for c, channel in enumerate(tr.channels):
-        _series(rec, f"{base}/scores/{channel}/score", tr.t, tr.score[:, c], channel)
-        _series(rec, f"{base}/scores/{channel}/threshold", tr.t[[0, -1]],
-                np.full(2, tr.threshold[c]), f"{channel} threshold", _RED)
-    for probe, values in tr.probes.items():
-        _series(rec, f"{base}/probes/{probe}", tr.t, values, probe)
+    _series_sets(rec, f"{base}/scores", tr.t, list(tr.channels), tr.score.T)
+    finite = np.isfinite(tr.threshold)
+    if finite.any():
+        rec.log(f"{base}/scores/threshold", rr.SeriesLines(
+            names=[f"{c} threshold" for c, f in zip(tr.channels, finite, strict=True) if f],
+            colors=[_RED] * int(finite.sum())), static=True)
+        rec.send_columns(f"{base}/scores/threshold",
+                         indexes=[rr.TimeColumn(TIMELINE, duration=tr.t[[0, -1]])],
+                         columns=rr.Scalars.columns(
+                             scalars=np.tile(tr.threshold[finite], (2, 1))))
+    if tr.probes:
+        _series_sets(rec, f"{base}/probes", tr.t, list(tr.probes),
+                     np.array(list(tr.probes.values())))
     r = ratio(tr)
     _series(rec, f"overview/{method}", tr.t, np.where(np.isinf(r), np.nan, r), method)
 

@@ -47,10 +47,25 @@ def test_the_recording_holds_signals_scores_probes_and_events(recording):
         assert rows[entity] == series(flight, s)[0].size
     armed = int(np.isfinite(trace.score[:, 0]).sum())
     assert armed > 0
-    assert rows["/methods/rls/scores/roll/score"] == armed
-    assert rows["/methods/rls/scores/roll/threshold"] == 2
-    assert rows["/methods/rls/probes/roll/residual"] == int(
-        np.isfinite(trace.probes["roll/residual"]).sum())
+    assert rows["/methods/rls/scores/0"] == armed
+    assert rows["/methods/rls/scores/threshold"] == 2
+    # probes finite at the same steps share an entity, one scalar each
+    sets = {}
+    for name, v in trace.probes.items():
+        sets.setdefault(np.isfinite(v).tobytes(), []).append(name)
+    assert len(sets) < len(trace.probes)
+    for k, names in enumerate(sets.values()):
+        assert rows[f"/methods/rls/probes/{k}"] == int(
+            np.isfinite(trace.probes[names[0]]).sum())
+    assert {e for e in rows if e.startswith("/methods/rls/probes/")} == {
+        f"/methods/rls/probes/{k}" for k in range(len(sets))}
+    names = {}
+    for chunk in reader.store().stream().to_chunks():
+        batch = chunk.to_record_batch()
+        for f in batch.schema:
+            if chunk.is_static and f.name.endswith(":names"):
+                names[chunk.entity_path] = batch.column(f.name).to_pylist()[0]
+    assert [names[f"/methods/rls/probes/{k}"] for k in range(len(sets))] == list(sets.values())
     assert rows["/overview/rls"] == armed
     assert rows["/overview/fault"] == 2            # the bar from onset to the fault's end
     alarms = len(trace.alarm_intervals())
