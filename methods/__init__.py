@@ -41,9 +41,9 @@ from .extremes import MaximaThresholds
 __all__ = ["BUILTIN", "BUILTIN_ENTRIES", "DEFAULT_RATE_HZ", "FAMILIES", "PLUGIN_GROUP", "REGISTRY",
            "CalibrationError", "Detector", "Fork", "Labelled", "MaximaThresholds",
            "NotFittedError", "PairDetector", "StaleStateError", "Trace", "clone", "continue_forks",
-           "detector_name", "fault_free_segments", "fit_token", "fork_for", "forks",
-           "labelled_segments", "make_detector", "plugins", "run_detector", "skipped_channels",
-           "source_digest", "training_segments"]
+           "detector_module", "detector_name", "fault_free_segments", "fit_token", "fork_for",
+           "forks", "labelled_segments", "make_detector", "plugins", "run_detector",
+           "skipped_channels", "source_digest", "training_segments"]
 
 #: the entry-point group third-party detectors register under
 PLUGIN_GROUP = "alfa_bench.methods"
@@ -108,6 +108,15 @@ def __getattr__(name: str):
     else:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     return globals()[name]
+
+
+def detector_module(name: str) -> str | None:
+    """The module that defines the registered detector ``name``, found without
+    importing it (None: no detector has that name). A cluster job parses the workflow,
+    which names every run's code, to run one detector."""
+    if name in BUILTIN_ENTRIES:
+        return f"{__name__}.{BUILTIN_ENTRIES[name].split(':')[0]}"
+    return next((ep.module for ep in entry_points(group=PLUGIN_GROUP, name=name)), None)
 
 
 def detector_name(detector: Detector) -> str:

@@ -16,7 +16,7 @@ from alfa_bench.workflow.stale import remove, stale_results
 from alfa_bench.workflow.resources import count_flights, job_resources
 from alfa_bench.outputs.provenance import RUN_FILE
 from alfa_bench.data import SIGNALS, resolve_alfa_dir
-from alfa_bench.methods import REGISTRY, make_detector
+from alfa_bench.methods import detector_module, make_detector
 
 METHODS = list(config["methods"])
 # the runs scored on the injected sensor faults and for isolation: the reference rows
@@ -67,7 +67,8 @@ def detector_code(method):
     A detector that wraps another (nested selection: ``params.detector``) runs on both."""
     spec = config["methods"][method]
     names = [spec["detector"], (spec.get("params") or {}).get("detector")]
-    return sorted({f for n in names if n in REGISTRY for f in module_sources(REGISTRY[n])})
+    modules = [detector_module(n) for n in names if n]
+    return sorted({f for m in modules if m for f in module_sources(m)})
 
 
 @functools.cache
