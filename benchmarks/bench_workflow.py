@@ -10,7 +10,7 @@
   false-alarm probability swept), over the flights once.
 - ``--changed``: the run over the flights once, then ``glrt_arx_chi2``'s false-alarm
   probability halved and ``snakemake all`` again: the re-run's wall time and the jobs it
-  ran, per rule.
+  ran, per rule; and the size of the first run's ``results/``, by folder.
 - ``--extra N``: every corpus also holds N more copies (every sixth flight, recorded
   three hours later on its date): ``--extra 7`` makes the 40 local flights a corpus of
   ALFA's 47.
@@ -147,6 +147,13 @@ def main() -> None:
             wall, _ = run(root, once, config, tmp / "changed", args.targets)
             memory["all, from empty"] = job_stats(tmp / "changed")
             print(f"| all, before the change | {found} | {len(base['methods'])} | {wall:.1f} |")
+            size = {}
+            for f in (tmp / "changed/results").rglob("*"):
+                if f.is_file() and not f.is_symlink():
+                    part = f.relative_to(tmp / "changed/results").parts[0]
+                    size[part] = size.get(part, 0) + f.stat().st_size
+            sizes = f"results/ {sum(size.values()) / 1e6:.0f} MB: " + ", ".join(
+                f"{p} {b / 1e6:.0f}" for p, b in sorted(size.items(), key=lambda x: -x[1]))
             changed = copy.deepcopy(base)
             changed["methods"]["glrt_arx_chi2"]["params"]["false_alarm"] /= 2
             config.write_text(yaml.safe_dump(changed))
@@ -154,6 +161,8 @@ def main() -> None:
             ran = ", ".join(f"{rule} {k}" for rule, k in sorted(jobs.items()))
             print(f"| all, after glrt_arx_chi2 changed ({ran}) | {found} | "
                   f"{len(base['methods'])} | {wall:.1f} |", flush=True)
+    if args.changed:
+        print(f"\n{sizes}")
     for case, stats in memory.items():
         print(f"\nJobs of {case}: wall s, peak resident MB")
         print("\n".join(f"- {job}: {s:.2f} s, {mb:.0f} MB" for job, (s, mb) in stats.items()))

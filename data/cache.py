@@ -15,7 +15,9 @@ Layout of the archive: ``meta`` (JSON text); per topic ``i``: ``i/t`` (s on the
 flight clock), ``i/lines``, one 2-D block per numeric type (``i/float64``,
 ``i/int64``, ``i/bool``: its columns in order), and per text column ``j``: ``i/j``
 (Unicode, ``i/j/na`` marking missing cells). Blocks keep the number of archive
-members, which dominates reading, small.
+members, which dominates reading, small. Members are deflated at level 1: a quarter of
+the size (62 MB -> 17 MB over the 40 local flights), read as fast (0.44 s against
+0.42 s for all 40).
 """
 
 from __future__ import annotations
@@ -63,7 +65,7 @@ def write_cached(flight: Flight, path: str | Path, sha256: str) -> None:
         topics.append({"name": topic.name, "file": topic.file, "columns": columns})
     meta = {"flight": flight.id, "path": str(flight.path), "t0_ns": flight.t0_ns,
             "repairs": list(flight.repairs), "sha256": sha256, "topics": topics}
-    write_npz(path, {"meta": np.array(json.dumps(meta)), **arrays})
+    write_npz(path, {"meta": np.array(json.dumps(meta)), **arrays}, compress=True)
 
 
 def write_npz(path: str | Path, arrays: dict[str, np.ndarray], compress: bool = False) -> None:
