@@ -309,7 +309,9 @@ def calibration_failure(flight: str, method: str, error: CalibrationError,
     advice = ("add fault-free flights (or flights with more time before onset) from other "
               "groups")
     if calibration["group_by"] != "flight":
-        advice += ", or set calibration.group_by: flight to leave out one flight, not one day"
+        advice += (", or set calibration.group_by: flight to leave out one flight, not one "
+                   "day (the runs are then reference rows: flights of the scored date "
+                   "train them)")
     return {"flight": flight, "stage": "calibration", "method": method, "file": "",
             "column": "", "line": "", "error": f"{error}; to calibrate, {advice}"}
 

@@ -339,8 +339,8 @@ def _rate(r, key: str) -> str:
 _BLOCK_TITLES = {"honest": "honest methods (sensors and setpoints only), ranked",
                  "reads actuators": "MARKED: reads what the fault emulation writes "
                                     "(servo outputs, throttle); not ranked",
-                 "reference": "reference rows: what lateness or the emulation alone gives; "
-                              "not ranked"}
+                 "reference": "reference rows: what lateness, the emulation alone or a "
+                              "calibration that saw the scored date gives; not ranked"}
 
 
 def _blocked(rows: list[tuple[str, list[str]]], width: int) -> list[list[str]]:

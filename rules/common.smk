@@ -51,6 +51,11 @@ for _name, _spec in config["methods"].items() if workflow.is_main_process else (
     if not _detector.causal and _spec.get("role", "method") != "reference":
         raise WorkflowError(f"config methods.{_name}: detector {_spec['detector']!r} is not "
                             "causal, so it can only be a reference row (role: reference)")
+    _grouping = _spec.get("calibration", {}).get("group_by", "date")
+    if _grouping != "date" and _spec.get("role", "method") != "reference":
+        raise WorkflowError(f"config methods.{_name}: calibration.group_by: {_grouping} lets "
+                            "flights of the scored date train it, so it can only be a "
+                            "reference row (role: reference)")
 
 
 # what a run taken out of the config left: named once, removed on request

@@ -73,6 +73,17 @@ def test_blocks_follow_the_role_and_the_inputs():
     assert block({"role": "method", "reads_actuators": False}) == "honest"
 
 
+def test_only_a_calibration_by_date_is_ranked_honest():
+    """A run whose calibration grouped flights by recording or flight was trained on
+    flights of the dates it scored: a reference row, whatever its config's role."""
+    for grouping, expected in [("date", "honest"), ("recording", "reference"),
+                               ("flight", "reference")]:
+        record = {"role": "method", "reads_actuators": False,
+                  "calibration": {"group_by": grouping, "margin_s": 1.0}}
+        assert block(record) == expected, grouping
+    assert block({"role": "method", "reads_actuators": False, "calibration": None}) == "honest"
+
+
 def _record(method, flight, onset, first, actuators=False, role="method"):
     return {"method": method, "flight": flight, "onset_s": onset, "first_alarm_s": first,
             "fault_class": "none" if onset is None else "engine", "detector": method,

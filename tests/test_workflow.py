@@ -404,6 +404,9 @@ def test_small_and_one_sided_flight_sets_run_to_the_end(specs, why, tmp_path):
      "config methods.x: detector 'rls_arx_zscore' has no parameter 'zthreshold'"),
     ("methods: {x: {detector: pyod, params: {model: IsolationTree}}}",
      "config methods.x: pyod model 'IsolationTree' with params {} cannot be built"),
+    ("methods: {x: {detector: residual_logistic, calibration: {group_by: recording}}}",
+     "config methods.x: calibration.group_by: recording lets flights of the scored date "
+     "train it, so it can only be a reference row (role: reference)"),
 ])
 def test_a_wrong_config_value_is_named_before_any_job_runs(corpus, tmp_path, config, message):
     (tmp_path / "bad.yaml").write_text(config + "\n")
