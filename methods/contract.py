@@ -42,6 +42,7 @@ import json
 import logging
 import shutil
 import tempfile
+from dataclasses import replace
 from functools import cache
 from pathlib import Path
 
@@ -273,25 +274,30 @@ def check_probes_are_named_once_and_do_not_change_the_run(detector: Detector) ->
 def check_batch_run_equals_streaming(detector: Detector) -> None:
     """A detector's own run() (batch or compiled) gives the scores and probes of update()
     step by step to rounding, and the same alarms wherever a score is not within
-    rounding of its threshold. (A non-causal reference's run() uses the whole flight
-    by design: skipped.)"""
+    rounding of its threshold, on the check flight and on the same flight with a NaN
+    row half-way (NaN where update()'s are). (A non-causal reference's run() uses the
+    whole flight by design: skipped.)"""
     d = _fitted(detector)
     if not d.causal:
         _skip("a non-causal reference: its run() uses the whole flight by design")
     s = sample(_flight(), d.signals(), d.rate_hz)
-    score, probes = d.run(s, probes=True)
-    ref_score, ref_probes = Detector.run(d, s, probes=True)
-    np.testing.assert_allclose(score, ref_score, rtol=1e-9, atol=1e-9,
-                               err_msg="run()'s scores differ from update()'s")
-    thr = d.thresholds()
-    tie = np.abs(ref_score - thr) <= 1e-9 * np.maximum(1.0, thr)
-    np.testing.assert_array_equal(d.alarms(score)[~tie], d.alarms(ref_score)[~tie],
-                                  err_msg="run()'s alarms differ from update()'s")
-    _expect(list(probes) == list(ref_probes), f"run()'s probes {list(ref_probes)}",
-            list(probes))
-    for name in probes:
-        np.testing.assert_allclose(probes[name], ref_probes[name], rtol=1e-9, atol=1e-9,
-                                   err_msg=f"probe {name} differs from update()'s")
+    # and a flight with a NaN row half-way, as a signal that has not started gives one
+    holed = replace(s, x=s.x.copy(), fresh=s.fresh.copy())
+    holed.x[s.t.size // 2] = np.nan
+    for flight, where in [(s, ""), (holed, " with a NaN row half-way")]:
+        score, probes = d.run(flight, probes=True)
+        ref_score, ref_probes = Detector.run(d, flight, probes=True)
+        np.testing.assert_allclose(score, ref_score, rtol=1e-9, atol=1e-9,
+                                   err_msg=f"run()'s scores differ from update()'s{where}")
+        thr = d.thresholds()
+        tie = np.abs(ref_score - thr) <= 1e-9 * np.maximum(1.0, thr)
+        np.testing.assert_array_equal(d.alarms(score)[~tie], d.alarms(ref_score)[~tie],
+                                      err_msg=f"run()'s alarms differ from update()'s{where}")
+        _expect(list(probes) == list(ref_probes), f"run()'s probes {list(ref_probes)}",
+                list(probes))
+        for name in probes:
+            np.testing.assert_allclose(probes[name], ref_probes[name], rtol=1e-9, atol=1e-9,
+                                       err_msg=f"probe {name} differs from update()'s{where}")
 
 
 @_check("make snapshot() hold every attribute update() changes (the default copies "

@@ -271,8 +271,9 @@ class OutlierModel(MaximaThresholds, Detector):
         self.last_ = math.nan
         if len(self.window_) == self.window_.maxlen:
             f = window_features(np.array(self.window_).T)
-            self.last_ = float(self._score(self.estimator_,
-                                           ((f - self.center_) / self.scale_)[None, :])[0])
+            if not np.isnan(f).any():        # as run_many: a window with a NaN scores NaN
+                self.last_ = float(self._score(self.estimator_,
+                                               ((f - self.center_) / self.scale_)[None, :])[0])
         return np.array([self.last_])
 
     def probes(self) -> dict[str, float]:

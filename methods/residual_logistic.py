@@ -286,8 +286,11 @@ class _ResidualClassifier:
                                   + self.intercept_))
         self.step_ += 1
         armed = len(self.logits_) == self.persist and self.step_ > self._steps(self.warmup_s)
+        # NaN if any logit of the window is, as run()'s min (Python's min would depend on
+        # where the NaN sits); armed on a finite minimum only, as run()
+        low = float(np.min(self.logits_)) if armed else math.nan            # m of (3)
         with np.errstate(under="ignore"):
-            return np.array([np.logaddexp(0.0, min(self.logits_)) if armed else math.nan])
+            return np.array([np.logaddexp(0.0, low) if math.isfinite(low) else math.nan])
 
     def probes(self) -> dict[str, float]:
         logits = getattr(self, "logits_", ())
