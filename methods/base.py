@@ -62,13 +62,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from alfa_bench.data import AlfaDataError, Flight, Sampled, not_measured, sample
+from alfa_bench.data import AlfaDataError, Flight, Sampled, not_measured, parse_flight_name, sample
 
 __all__ = ["DEFAULT_RATE_HZ", "FAMILIES", "CalibrationError", "Detector", "Fork", "Labelled",
            "NotFittedError", "PairDetector", "StaleStateError", "Trace", "clone",
            "continue_forks", "fault_free_segments", "fit_token", "fork_for", "forks",
-           "json_ready", "labelled_segments", "learned_state", "run_detector",
-           "skipped_channels", "source_digest", "training_segments"]
+           "free_part", "json_ready", "labelled_segments", "learned_state",
+           "leave_one_date_out", "run_detector", "skipped_channels", "source_digest",
+           "training_segments"]
 
 log = logging.getLogger(__name__)
 
@@ -767,6 +768,26 @@ def labelled_segments(detector: Detector, flights: list[Flight]) -> list[Labelle
                                  flight.fault.onset_s, flight.fault.fault_class,
                                  flight.emergency_trajectory))
     return segments
+
+
+def free_part(segment: Labelled, margin_s: float) -> Sampled:
+    """The fault-free part of a labelled ``segment``, as :func:`fault_free_segments`
+    cuts a flight: all of it if fault-free, else its steps before ``onset - margin_s``
+    (possibly none)."""
+    if segment.onset_s is None:
+        return segment.sampled
+    return segment.sampled.before(segment.onset_s - margin_s)
+
+
+def leave_one_date_out(segments: list) -> list[tuple[str, list, list]]:
+    """The folds of an out-of-sample calibration: per date of ``segments`` (anything with
+    a ``flight``: :class:`~alfa_bench.data.Sampled`, :class:`Labelled`), in date order,
+    the date, the segments of every other date, and that date's. A model fitted on a
+    fold's first list has seen no flight of its date."""
+    dates = [str(parse_flight_name(s.flight)["date"]) for s in segments]
+    return [(d, [s for s, sd in zip(segments, dates, strict=True) if sd != d],
+             [s for s, sd in zip(segments, dates, strict=True) if sd == d])
+            for d in sorted(set(dates))]
 
 
 def training_segments(detector: Detector, flights: list[Flight],

@@ -55,7 +55,7 @@ import numpy as np
 from alfa_bench.data import Sampled
 from alfa_bench.data.flight import parse_flight_name
 
-from .base import CalibrationError, Detector, Labelled
+from .base import CalibrationError, Detector, Labelled, free_part
 
 __all__ = ["INNER_FITS", "NestedSelection", "held_out_right"]
 
@@ -194,12 +194,7 @@ class NestedSelection(Detector):
 
     def _free(self, flights: list[Labelled]) -> list[Sampled]:
         """The fault-free segments of ``flights``, as the workflow calibrates."""
-        out = []
-        for f in flights:
-            s = f.sampled if f.onset_s is None else f.sampled.before(f.onset_s - self.margin_s)
-            if s.t.size:
-                out.append(s)
-        return out
+        return [s for s in (free_part(f, self.margin_s) for f in flights) if s.t.size]
 
     def _scored(self, flight: Labelled) -> bool:
         return self.score_emr or not str(

@@ -16,14 +16,15 @@ does, and min-max scaled for a river model, as river's ``MinMaxScaler`` does bef
 half-space tree. The model is the library's, with its defaults (a seed is set where
 it takes one and none was given, so that a run repeats); it is fitted on the
 fault-free segments of the other dates, a river model learning them row by row and
-then frozen. Its outlier score (PyOD's ``decision_function``, river's ``score_one``)
-is the channel's score.
+then frozen (a half-space tree's window is widened to every row learned, so that its
+reference is all of them, not the last 250). Its outlier score (PyOD's
+``decision_function``, river's ``score_one``) is the channel's score.
 
 Thresholds come from per-flight maxima (:class:`~.extremes.MaximaThresholds`), taken
-out of sample: the calibration flights are split in two alternate halves, each
-half's maxima scored by the model fitted on the other (a model scores its own
-training rows low: a nearest-neighbour distance is then zero), and the model that
-scores is fitted on all of them. A flight is scored in one batch call of the model
+out of sample: each calibration flight is scored by the model fitted on the flights
+of the other dates (a model scores its own training rows low: a nearest-neighbour
+distance is then zero; and flights of one date share its weather and trim), and the
+model that scores is fitted on all of them. A flight is scored in one batch call of the model
 (:meth:`OutlierModel.run`): a PyOD model costs milliseconds a call and microseconds a
 row.
 """
@@ -45,7 +46,7 @@ from numpy.lib.stride_tricks import sliding_window_view
 
 from alfa_bench.data import Sampled
 
-from .base import CalibrationError, Detector, StaleStateError, fit_token
+from .base import CalibrationError, Detector, StaleStateError, fit_token, leave_one_date_out
 from .extremes import MaximaThresholds
 from .windows import window_steps
 
@@ -208,13 +209,16 @@ class OutlierModel(MaximaThresholds, Detector):
         return self
 
     def fit(self, segments: list[Sampled]) -> OutlierModel:
-        """Per-flight maxima out of sample (module docstring), then the model fitted on
-        every segment and the thresholds."""
-        if len(segments) < 2:
-            raise CalibrationError(f"{self.channels()[0]}: {len(segments)} calibration "
-                                   "segments; the out-of-sample maxima need two or more")
-        halves = segments[0::2], segments[1::2]
-        return self.fit_out_of_sample(segments, [halves, halves[::-1]])
+        """Per-flight maxima out of sample (module docstring), each by the model fitted
+        without the flight's date; then the model fitted on every segment, and the
+        thresholds."""
+        folds = leave_one_date_out(segments)
+        if len(folds) < 2:
+            raise CalibrationError(f"{self.channels()[0]}: calibration segments of "
+                                   f"{len(folds)} date(s); the out-of-sample maxima need "
+                                   "two dates or more")
+        return self.fit_out_of_sample(segments, [(training, held)
+                                                 for _, training, held in folds])
 
     def fitted(self) -> dict:
         """The maxima and thresholds, and the model: its library, name, parameters,
@@ -281,9 +285,11 @@ class OutlierModel(MaximaThresholds, Detector):
 
 
 def _params(estimator) -> dict:
+    """The parameters ``estimator`` was built with: scikit-learn's and PyOD's
+    ``get_params``, river's ``_get_params``."""
     get = getattr(estimator, "get_params", None)
     if get is None:
-        return {}
+        return estimator._get_params() if hasattr(estimator, "_get_params") else {}
     try:
         return get(deep=False)
     except TypeError:
@@ -398,6 +404,11 @@ class RiverDetector(OutlierModel):
         return low, np.where(high > low, high - low, 1.0)
 
     def _fit_estimator(self, estimator, X):
+        params = estimator._get_params()
+        if params.get("window_size", len(X)) < len(X):
+            # HalfSpaceTrees scores against its last complete window of rows learned: a
+            # window of every row, or it would know only the last ones (250 by default)
+            estimator = estimator.clone({"window_size": len(X)})
         for row in X:
             estimator.learn_one(dict(enumerate(row.tolist())))
         return estimator

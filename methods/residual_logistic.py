@@ -79,9 +79,18 @@ from collections import deque
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
-from alfa_bench.data import Sampled, parse_flight_name
+from alfa_bench.data import Sampled
 
-from .base import CalibrationError, Detector, Labelled, StaleStateError, fit_token, json_ready
+from .base import (
+    CalibrationError,
+    Detector,
+    Labelled,
+    StaleStateError,
+    fit_token,
+    free_part,
+    json_ready,
+    leave_one_date_out,
+)
 from .extremes import MaximaThresholds
 from .windows import window_steps
 
@@ -346,21 +355,16 @@ class ResidualLogistic(_ResidualClassifier, MaximaThresholds, Detector):
         self.false_alarm = false_alarm
         self.rate_hz = rate_hz
 
-    def _free(self, segments: list[Labelled]) -> list[Sampled]:
-        """The fault-free segments of ``segments``."""
-        return [seg.sampled if seg.onset_s is None else
-                seg.sampled.before(seg.onset_s - self.margin_s) for seg in segments]
-
     def fit(self, segments: list[Labelled]) -> ResidualLogistic:
         """Per-flight maxima, each by the model fitted without the flight's date; then
         the model on every segment, and the thresholds."""
-        dates = [parse_flight_name(seg.flight)["date"] for seg in segments]
-        if len(set(dates)) < 2:
+        folds = leave_one_date_out(segments)
+        if len(folds) < 2:
             raise CalibrationError("residual logistic: the out-of-sample maxima need "
-                                   f"training flights of two dates or more, got {set(dates)}")
-        splits = [([seg for seg, d in zip(segments, dates, strict=True) if d != date],
-                   [s for s, d in zip(self._free(segments), dates, strict=True)
-                    if d == date and s.t.size]) for date in sorted(set(dates))]
+                                   "training flights of two dates or more, got "
+                                   f"{[d for d, _, _ in folds]}")
+        splits = [(training, [s for s in (free_part(h, self.margin_s) for h in held)
+                              if s.t.size]) for _, training, held in folds]
         return self.fit_out_of_sample(segments, splits)
 
     def fitted(self) -> dict:

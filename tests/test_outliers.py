@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import alfa_bench as ab
+from alfa_bench.data import parse_flight_name
 from alfa_bench.methods import make_detector, training_segments
 from alfa_bench.methods.outliers import PyODDetector, RiverDetector, alone_ecdf_scores
 
@@ -37,11 +38,24 @@ def test_a_seed_is_set_only_where_none_was_given():
     assert not hasattr(PyODDetector("HBOS")._build(), "random_state")
 
 
-def test_maxima_are_out_of_sample_and_cover_every_segment(corpus_flights):
+def test_maxima_are_out_of_sample_by_date_and_cover_every_segment(corpus_flights,
+                                                                   monkeypatch):
     d = make_detector("pyod", {"model": "KNN"})
     flights = [f for f in corpus_flights.values() if f.fault is not None]
     segments = training_segments(d, flights, margin_s=1.0)
+    date = {s.flight: str(parse_flight_name(s.flight)["date"]) for s in segments}
+    assert len(set(date.values())) > 1
+    fitted_on, seen = [], []
+    fit_model, segment_maxima = type(d).fit_model, type(d).segment_maxima
+    monkeypatch.setattr(type(d), "fit_model", lambda self, segs: (
+        fitted_on.append({date[s.flight] for s in segs}), fit_model(self, segs))[1])
+    monkeypatch.setattr(type(d), "segment_maxima", lambda self, segs: (
+        seen.append((fitted_on[-1], {date[s.flight] for s in segs})),
+        segment_maxima(self, segs))[1])
     d.fit(segments)
+    # every flight's maximum by a model that saw no flight of its date
+    assert seen and all(not (trained & held) for trained, held in seen)
+    assert fitted_on[-1] == set(date.values())              # the model that scores: all
     channel = d.channels()[0]
     assert sorted(d.maxima_flights_[channel]) == sorted(s.flight for s in segments)
     # in sample, a neighbour model scores its own rows lower: its maxima would be lower
@@ -72,3 +86,18 @@ def test_a_pyod_model_is_found_by_its_class_whatever_its_module():
                                          "IsolationTree.*What to do: name a model class"):
         make_detector("pyod", {"model": "IsolationTree"}).check_params()
     make_detector("pyod", {"model": "HBOS"}).check_params()
+
+
+def test_a_half_space_tree_knows_every_row_it_learned(corpus_flights):
+    """river's HalfSpaceTrees scores against its last complete window of rows: the
+    window is widened to every row learned, and the fit report lists the model's
+    parameters."""
+    d = make_detector("river", {"model": "HalfSpaceTrees"})
+    flights = [f for f in corpus_flights.values() if f.fault is not None]
+    d.fit(training_segments(d, flights, margin_s=1.0))
+    assert d.rows_ > 250
+    assert d.estimator_.window_size == d.rows_
+    # the reference mass at each tree's root: every row learned
+    assert all(tree.r_mass == d.rows_ for tree in d.estimator_.trees)
+    params = d.fitted()["model"]["params"]
+    assert params["window_size"] == d.rows_ and params["height"] == 8 and params["seed"] == 0
