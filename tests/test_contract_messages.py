@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 
 from alfa_bench.data import UnknownSignalError
-from alfa_bench.methods.base import Detector
+from alfa_bench.methods.base import CalibrationError, Detector
 from alfa_bench.methods.contract import CHECKS, ContractError, quick_check
+from alfa_bench.methods.extremes import MaximaThresholds
 
 
 class Sound(Detector):
@@ -123,3 +124,44 @@ def test_the_quick_checks_say_what_went_wrong(detector, error, said):
         quick_check(detector)
     assert said in str(e.value), str(e.value)
     quick_check(Sound())
+
+
+class CannotCalibrate(MaximaThresholds, Detector):
+    """Its model fits on the check corpus, its thresholds never do."""
+
+    def __init__(self, false_alarm=0.1):
+        self.false_alarm = false_alarm
+
+    def signals(self):
+        return ("pitch_error",)
+
+    def fit_model(self, segments):
+        self.offset_ = 0.0
+        return self
+
+    def fit(self, segments):
+        self.fit_model(segments)
+        raise CalibrationError("CannotCalibrate: too few fault-free flights here")
+
+    def update(self, x, fresh):
+        return x[:1] - self.offset_
+
+
+class LooksAhead(CannotCalibrate):
+    """The same, its batch run centred on the whole flight's mean: not causal."""
+
+    def run(self, s, probes=False, start=0, state=None):
+        return s.x[start:, :1] - np.nanmean(s.x[:, 0]) - self.offset_, {}
+
+
+def test_a_detector_the_corpus_cannot_calibrate_is_still_checked(caplog):
+    """The checks that need no fit run, and causality on the model's scores: a
+    look-ahead is caught although no threshold could be set; the checks left to the
+    real flights are named."""
+    with pytest.raises(ContractError, match=r"(?s)contract check causal: .*outputs before it"):
+        quick_check(LooksAhead())
+    caplog.clear()
+    quick_check(CannotCalibrate())
+    (said,) = [r.getMessage() for r in caplog.records if "left to the real flights" in
+               r.getMessage()]
+    assert "outputs_have_the_declared_shape" in said and "causal" not in said, said
