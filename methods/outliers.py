@@ -140,17 +140,24 @@ class OutlierModel(MaximaThresholds, Detector):
         try:
             self._build()
         except ImportError as e:
-            raise ValueError(
-                f"{self.library} model {self._name()!r} cannot be built: it needs "
-                f"{e.name}, which alfa-bench does not install ({e}). What to do: "
-                f"pip install {e.name} (PyOD's deep models need torch), or name another "
-                "model") from None
+            needs = (f"it needs {e.name}, which alfa-bench does not install ({e}). What to "
+                     f"do: pip install {e.name}" if e.name else
+                     f"it cannot import what it needs ({e}). What to do: install that")
+            raise ValueError(f"{self.library} model {self._name()!r} cannot be built: "
+                             f"{needs} (PyOD's deep models need torch), or name another "
+                             "model") from None
         except (AttributeError, TypeError) as e:
             raise ValueError(
                 f"{self.library} model {self._name()!r} with params {self.params or {}} "
                 f"cannot be built: {type(e).__name__}: {e}. What to do: name a model class "
                 f"{self.library} has (its documentation lists them) and parameters it "
                 "takes") from None
+        except Exception as e:      # a module that half-imported without its extra
+            raise ValueError(
+                f"{self.library} model {self._name()!r} cannot be built: "
+                f"{type(e).__name__}: {e} (PyOD's deep models need torch, which "
+                "alfa-bench does not install). What to do: pip install torch, or name "
+                "another model") from None
 
     @staticmethod
     def _seed_name(cls) -> str | None:
