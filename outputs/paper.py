@@ -113,6 +113,12 @@ def paper_numbers(comparison: pd.DataFrame, sweep: pd.DataFrame, leakage: pd.Dat
     (:func:`~alfa_bench.analysis.public_study.against_study`); ``left_out`` the flights
     off the common ground (``left_out.csv``)."""
     out = {f"{k}:{m}:{s}": "n/a" for k in _PER_RUN for m in methods for s in subsets}
+    # every subset's own numbers first, so that a flight set with no flight of a subset
+    # (or every one of them left out) still renders
+    out |= {f"{k}:{s}": "n/a" for s in subsets
+            for k in ("flights", "faultfree", "faultflights", "ground", "bestaccuracy",
+                      "bestdetected", "bestfalsealarms", "beststable")}
+    out |= {f"{k}:{s}": "none" for s in subsets for k in ("best", "tied")}
     out |= {f"paper:{k}": (_pct if k in ("precision", "recall", "accuracy") else _sec)(
         ICRA2019_SUMMARY[key])
         for k, key in (("precision", "precision"), ("recall", "recall"),

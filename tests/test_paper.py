@@ -183,3 +183,13 @@ def test_the_prose_types_no_count_or_rate():
     tex = re.sub(r"\\result\{[^}]*\}|\\texttt\{[^}]*\}|\$[^$]*\$", "", tex)
     tex = re.sub(r"\\begin\{equation\}.*?\\end\{equation\}", "", tex, flags=re.S)
     assert _typed_results(tex, r"\\,\\%") == []
+
+
+def test_a_subset_without_a_scored_flight_still_renders():
+    """A configured subset none of whose flights was scored (a small corpus, or all of
+    them left out) quotes "none" and "n/a" rather than stopping the paper."""
+    n = paper_numbers(comparison(), sweep(), leakage(), methods=("a", "b"),
+                      subsets=("no_emr", "all"))
+    assert (n["best:no_emr"], n["bestaccuracy:no_emr"], n["tied:no_emr"]) == ("none", "n/a",
+                                                                              "none")
+    assert n["flights:no_emr"] == "n/a" and n["best:all"] == "b"
