@@ -309,9 +309,9 @@ def calibration_failure(flight: str, method: str, error: CalibrationError,
     advice = ("add fault-free flights (or flights with more time before onset) from other "
               "groups")
     if calibration["group_by"] != "flight":
-        advice += (", or set calibration.group_by: flight to leave out one flight, not one "
-                   "day (the runs are then reference rows: flights of the scored date "
-                   "train them)")
+        advice += (", or set calibration.group_by: flight on the run, with role: "
+                   "reference, to leave out one flight, not one day (flights of the scored "
+                   "date then train it, so it is not ranked)")
     return {"flight": flight, "stage": "calibration", "method": method, "file": "",
             "column": "", "line": "", "error": f"{error}; to calibrate, {advice}"}
 

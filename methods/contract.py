@@ -102,10 +102,10 @@ def _fitted(detector: Detector) -> Detector:
     if key not in _FITTED:
         try:
             _FITTED[key] = _fit(copy.deepcopy(detector))
-        except CalibrationError as e:       # kept too: each check needing a fit asks
-            _FITTED[key] = e
+        except CalibrationError as e:       # kept too (its words): each check asks again
+            _FITTED[key] = CalibrationError(*e.args)
     if isinstance(_FITTED[key], CalibrationError):
-        raise _FITTED[key]
+        raise CalibrationError(*_FITTED[key].args)
     return copy.deepcopy(_FITTED[key])
 
 
@@ -513,7 +513,7 @@ def _model_only(detector: Detector) -> Detector | None:
     training = [load_flight(p) for p in sorted(_corpus().iterdir())]
     try:
         return d.fit_model(training_segments(d, training, margin_s=1.0))
-    except CalibrationError:
+    except Exception:   # its model alone cannot fit either: the real flights will say
         return None
 
 

@@ -16,7 +16,7 @@ does, and min-max scaled for a river model, as river's ``MinMaxScaler`` does bef
 half-space tree. The model is the library's, with its defaults (a seed is set where
 it takes one and none was given, so that a run repeats); it is fitted on the
 fault-free segments of the other dates, a river model learning them row by row and
-then frozen (a half-space tree's window is widened to every row learned, so that its
+then frozen (a half-space tree's window, unless set, is every row learned, so that its
 reference is all of them, not the last 250). Its outlier score (PyOD's
 ``decision_function``, river's ``score_one``) is the channel's score.
 
@@ -146,13 +146,13 @@ class OutlierModel(MaximaThresholds, Detector):
             raise ValueError(f"{self.library} model {self._name()!r} cannot be built: "
                              f"{needs} (PyOD's deep models need torch), or name another "
                              "model") from None
-        except (AttributeError, TypeError) as e:
+        except (AttributeError, TypeError, ValueError) as e:
             raise ValueError(
                 f"{self.library} model {self._name()!r} with params {self.params or {}} "
                 f"cannot be built: {type(e).__name__}: {e}. What to do: name a model class "
                 f"{self.library} has (its documentation lists them) and parameters it "
                 "takes") from None
-        except Exception as e:      # a module that half-imported without its extra
+        except NameError as e:      # a module that half-imported without torch
             raise ValueError(
                 f"{self.library} model {self._name()!r} cannot be built: "
                 f"{type(e).__name__}: {e} (PyOD's deep models need torch, which "
@@ -411,10 +411,11 @@ class RiverDetector(OutlierModel):
         return low, np.where(high > low, high - low, 1.0)
 
     def _fit_estimator(self, estimator, X):
-        params = estimator._get_params()
-        if params.get("window_size", len(X)) < len(X):
-            # HalfSpaceTrees scores against its last complete window of rows learned: a
-            # window of every row, or it would know only the last ones (250 by default)
+        if ("window_size" in estimator._get_params()
+                and "window_size" not in (self.params or {})):
+            # HalfSpaceTrees scores against its last complete window of rows learned: one
+            # window of every row, or it would know only the last 250 (river's default),
+            # or none at all from fewer rows
             estimator = estimator.clone({"window_size": len(X)})
         for row in X:
             estimator.learn_one(dict(enumerate(row.tolist())))

@@ -15,6 +15,7 @@ from alfa_bench.workflow.logs import failed_flights_line
 from alfa_bench.workflow.stale import remove, stale_results
 from alfa_bench.workflow.resources import count_flights, job_resources
 from alfa_bench.outputs.provenance import RUN_FILE
+from alfa_bench.analysis.held_out import own_calibration
 from alfa_bench.data import SIGNALS, resolve_alfa_dir
 from alfa_bench.methods import detector_module, make_detector
 
@@ -51,7 +52,8 @@ for _name, _spec in config["methods"].items() if workflow.is_main_process else (
     if not _detector.causal and _spec.get("role", "method") != "reference":
         raise WorkflowError(f"config methods.{_name}: detector {_spec['detector']!r} is not "
                             "causal, so it can only be a reference row (role: reference)")
-    _grouping = _spec.get("calibration", {}).get("group_by", "date")
+    # the run's own grouping, else the config's: either way it is the run's
+    _grouping = own_calibration(config["calibration"], _spec)["group_by"]
     if _grouping != "date" and _spec.get("role", "method") != "reference":
         raise WorkflowError(f"config methods.{_name}: calibration.group_by: {_grouping} lets "
                             "flights of the scored date train it, so it can only be a "

@@ -101,6 +101,15 @@ def test_a_half_space_tree_knows_every_row_it_learned(corpus_flights):
     assert all(tree.r_mass == d.rows_ for tree in d.estimator_.trees)
     params = d.fitted()["model"]["params"]
     assert params["window_size"] == d.rows_ and params["height"] == 8 and params["seed"] == 0
+    # fewer rows than river's default window: still one window of every row
+    few = make_detector("river", {"model": "HalfSpaceTrees", "max_rows": 100})
+    few.fit(training_segments(few, flights, margin_s=1.0))
+    assert few.rows_ == few.estimator_.window_size == 100
+    # a window the run sets is its own
+    own = make_detector("river", {"model": "HalfSpaceTrees",
+                                  "params": {"window_size": 50}})
+    own.fit(training_segments(own, flights, margin_s=1.0))
+    assert own.estimator_.window_size == 50
 
 
 def test_every_pyod_model_class_builds_or_says_why():
@@ -127,3 +136,6 @@ def test_every_pyod_model_class_builds_or_says_why():
         else:
             built.append(name)
     assert {"IForest", "KNN", "HBOS", "ECOD", "COPOD", "PCA", "LOF", "OCSVM"} <= set(built)
+    # a parameter out of range is the parameter's fault, not a missing package's
+    with pytest.raises(ValueError, match="with params .*contamination.* takes"):
+        make_detector("pyod", {"model": "KNN", "params": {"contamination": 0.9}}).check_params()

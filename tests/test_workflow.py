@@ -407,6 +407,8 @@ def test_small_and_one_sided_flight_sets_run_to_the_end(specs, why, tmp_path):
     ("methods: {x: {detector: residual_logistic, calibration: {group_by: recording}}}",
      "config methods.x: calibration.group_by: recording lets flights of the scored date "
      "train it, so it can only be a reference row (role: reference)"),
+    ("calibration: {group_by: flight, margin_s: 1.0}",
+     "calibration.group_by: flight lets flights of the scored date train it"),
 ])
 def test_a_wrong_config_value_is_named_before_any_job_runs(corpus, tmp_path, config, message):
     (tmp_path / "bad.yaml").write_text(config + "\n")
