@@ -55,7 +55,7 @@ import numpy as np
 from alfa_bench.data import Sampled
 from alfa_bench.data.flight import parse_flight_name
 
-from .base import CalibrationError, Detector, Labelled, free_part
+from .base import CalibrationError, Detector, Labelled, free_part, leave_one_date_out
 
 __all__ = ["INNER_FITS", "NestedSelection", "held_out_right"]
 
@@ -204,21 +204,18 @@ class NestedSelection(Detector):
         for attr in ("chosen_", "inner_", "base_"):
             self.__dict__.pop(attr, None)
         made = self._check_grid()
-        date = [str(parse_flight_name(f.flight)["date"]) for f in segments]
-        dates = list(dict.fromkeys(date))
-        if len(dates) < 2:
+        folds = leave_one_date_out(segments)
+        if len(folds) < 2:
             raise CalibrationError(f"nested selection needs training flights of two dates or "
-                                   f"more; found {len(dates)}")
-        digest = [_digest(f.sampled) for f in segments]
+                                   f"more; found {len(folds)}")
+        digest = {id(f): _digest(f.sampled) for f in segments}
         candidates, groups = self.candidates(), _sharing(made)
         tally = [{"scored": 0, "right": 0, "unfit": []} for _ in made]
-        for d in dates:
-            held = [f for f, fd in zip(segments, date, strict=True)
-                    if fd == d and self._scored(f)]
+        for d, training, held in folds:
+            held = [f for f in held if self._scored(f)]
             if not held:
                 continue
-            data = tuple(h for h, fd in zip(digest, date, strict=True) if fd != d)
-            training = [f for f, fd in zip(segments, date, strict=True) if fd != d]
+            data = tuple(digest[id(f)] for f in training)
             for group in groups:
                 fits = {i: self._inner_fit(i, group[0], made, data, training) for i in group}
                 for i in group:

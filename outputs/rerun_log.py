@@ -103,10 +103,13 @@ def blueprint(methods: list[str], groups: list[str], title: str = "",
         rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"))
 
 
-def _series(rec: rr.RecordingStream, path: str, t: np.ndarray, v: np.ndarray, name: str,
+def _series(rec: rr.RecordingStream, path: str, t: np.ndarray, v: np.ndarray, name,
             color=None, step: bool = False) -> None:
-    keep = np.isfinite(v)
-    if not keep.any():
+    """Series ``v`` at ``path``: one (``v`` of shape (n,), ``name`` a string) or several
+    finite at the same steps (``v`` of shape (n, k), ``name`` and ``color`` lists of k),
+    at the steps where they are finite."""
+    keep = np.isfinite(v) if v.ndim == 1 else np.isfinite(v).all(axis=1)
+    if not v.size or not keep.any():
         return
     rec.log(path, rr.SeriesLines(names=name, colors=color,
                                  interpolation_mode="StepAfter" if step else None),
@@ -126,11 +129,7 @@ def _series_sets(rec: rr.RecordingStream, base: str, t: np.ndarray, names: list[
         if finite.any():
             sets.setdefault(finite.tobytes(), []).append(i)
     for k, members in enumerate(sets.values()):
-        keep = np.isfinite(values[members[0]])
-        rec.log(f"{base}/{k}", rr.SeriesLines(names=[names[i] for i in members]),
-                static=True)
-        rec.send_columns(f"{base}/{k}", indexes=[rr.TimeColumn(TIMELINE, duration=t[keep])],
-                         columns=rr.Scalars.columns(scalars=values[members][:, keep].T))
+        _series(rec, f"{base}/{k}", t, values[members].T, [names[i] for i in members])
 
 
 def _alarm_events(method: str, tr: Trace) -> list[tuple[float, str, str]]:
@@ -156,14 +155,10 @@ def _method_entities(rec: rr.RecordingStream, method: str, tr: Trace) -> None:
     base = f"methods/{method}"
     _series_sets(rec, f"{base}/scores", tr.t, list(tr.channels), tr.score.T)
     finite = np.isfinite(tr.threshold)
-    if finite.any():
-        rec.log(f"{base}/scores/threshold", rr.SeriesLines(
-            names=[f"{c} threshold" for c, f in zip(tr.channels, finite, strict=True) if f],
-            colors=[_RED] * int(finite.sum())), static=True)
-        rec.send_columns(f"{base}/scores/threshold",
-                         indexes=[rr.TimeColumn(TIMELINE, duration=tr.t[[0, -1]])],
-                         columns=rr.Scalars.columns(
-                             scalars=np.tile(tr.threshold[finite], (2, 1))))
+    _series(rec, f"{base}/scores/threshold", tr.t[[0, -1]],
+            np.tile(tr.threshold[finite], (2, 1)),
+            [f"{c} threshold" for c, f in zip(tr.channels, finite, strict=True) if f],
+            [_RED] * int(finite.sum()))
     if tr.probes:
         _series_sets(rec, f"{base}/probes", tr.t, list(tr.probes),
                      np.array(list(tr.probes.values())))
