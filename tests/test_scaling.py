@@ -41,8 +41,8 @@ def test_job_resources_grow_with_the_flights_and_the_attempt(tmp_path):
     assert count_flights(tmp_path) == 3
     assert count_flights(tmp_path / "not yet downloaded") == 47
     small, large = job_resources(40), job_resources(4700)
-    assert small["mem_mb"](None, 1) == 1200 and small["runtime"](None, 1) == 5
-    assert large["mem_mb"](None, 1) == 47_800 and large["runtime"](None, 1) == 118
+    assert small["mem_mb"](None, 1) == 1300 and small["runtime"](None, 1) == 5
+    assert large["mem_mb"](None, 1) == 66_600 and large["runtime"](None, 1) == 294
     assert small["mem_mb"](None, 2) == 2 * small["mem_mb"](None, 1)
     assert large["runtime"](None, 3) == 3 * large["runtime"](None, 1)
 
