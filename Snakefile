@@ -38,6 +38,7 @@ rule all:
         rules.index_page.output,
         rules.per_flight.output,
         rules.protocol_steps.output,
+        rules.features_learners.output,
         rules.deadline.output,
         rules.leakage.output,
         rules.ceiling.output,

@@ -45,7 +45,7 @@ from .isolation import named_class, names_class
 from .scoring import flight_outcome
 from .stability import survival
 
-__all__ = ["margins", "per_flight_markdown", "per_flight_table", "verdict"]
+__all__ = ["margins", "per_flight_markdown", "per_flight_table", "subset_counts", "verdict"]
 
 
 def verdict(onset_s: float | None, first_alarm_s: float | None, channel: str | None,
@@ -150,3 +150,20 @@ def per_flight_markdown(table: pd.DataFrame, deadline_s: float) -> str:
                            fmt(r["margin_before"]), fmt(r["survival"])]
                           for r in rows.to_dict(orient="records")]))
     return markdown(sections)
+
+
+def subset_counts(runs: pd.DataFrame, members: set[str], stable: float) -> dict:
+    """One run's rows of the per-flight table on the flights ``members``: its faulty
+    flights and the faults detected in time, the faulty flights alarmed before onset,
+    the fault-free flights and those alarmed, and the detections stable under resampled
+    calibration pools (survival >= ``stable``; None where the run has no pools)."""
+    sub = runs[runs["flight"].isin(members)]
+    faulty = sub["fault_class"] != "none"
+    early = sub["first_alarm_s"] < sub["onset_s"]
+    in_time = faulty & (sub["outcome"] == "TP")
+    return {"faulty_flights": int(faulty.sum()), "detected": int(in_time.sum()),
+            "early_alarms": int((faulty & early).sum()),
+            "fault_free_flights": int((~faulty).sum()),
+            "fault_free_alarmed": int((~faulty & sub["first_alarm_s"].notna()).sum()),
+            "stable_detections": (int((in_time & (sub["survival"] >= stable)).sum())
+                                  if sub["survival"].notna().any() else None)}

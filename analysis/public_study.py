@@ -17,6 +17,7 @@ import pandas as pd
 from alfa_bench.data import subset_flights
 from alfa_bench.render import fmt, markdown
 
+from .per_flight import subset_counts
 from .scoring import flight_outcome
 
 __all__ = ["STUDY_FLIGHTS", "STUDY_NAME", "STUDY_SUMMARY", "against_study",
@@ -170,20 +171,10 @@ def protocol_steps(per_flight: pd.DataFrame, manifest: pd.DataFrame, steps: list
         runs = per_flight[per_flight["method"] == step["run"]]
         if runs.empty:
             continue
-        sub = runs[runs["flight"].isin(members)]
-        faulty = sub["fault_class"] != "none"
-        early = sub["first_alarm_s"] < sub["onset_s"]
-        in_time = faulty & (sub["outcome"] == "TP")
         counts = study_counts(study_outcome(o, a) for o, a in
                               zip(runs["onset_s"], runs["first_alarm_s"], strict=True))
         rows.append({"step": i, "run": step["run"], "change": step["change"],
-                     "faulty_flights": int(faulty.sum()), "detected": int(in_time.sum()),
-                     "early_alarms": int((faulty & early).sum()),
-                     "fault_free_flights": int((~faulty).sum()),
-                     "fault_free_alarmed": int((~faulty & sub["first_alarm_s"].notna()).sum()),
-                     "stable_detections": (int((in_time & (sub["survival"] >= stable)).sum())
-                                           if sub["survival"].notna().any() else None),
-                     "flights": len(runs),
+                     **subset_counts(runs, members, stable), "flights": len(runs),
                      **{f"{k}_study_rule": v for k, v in counts.items()}})
     return pd.DataFrame(rows)
 

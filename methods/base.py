@@ -68,8 +68,8 @@ __all__ = ["DEFAULT_RATE_HZ", "FAMILIES", "CalibrationError", "Detector", "Fork"
            "NotFittedError", "PairDetector", "StaleStateError", "Trace", "clone",
            "continue_forks", "fault_free_segments", "fit_token", "fork_for", "forks",
            "free_part", "json_ready", "labelled_segments", "learned_state",
-           "leave_one_date_out", "run_detector", "skipped_channels", "source_digest",
-           "training_segments"]
+           "leave_one_date_out", "run_detector", "segment_digest", "skipped_channels",
+           "source_digest", "training_segments"]
 
 log = logging.getLogger(__name__)
 
@@ -777,6 +777,15 @@ def free_part(segment: Labelled, margin_s: float) -> Sampled:
     if segment.onset_s is None:
         return segment.sampled
     return segment.sampled.before(segment.onset_s - margin_s)
+
+
+def segment_digest(s: Sampled) -> bytes:
+    """What identifies a segment's data: its flight, times, values and freshness (a key
+    under which a fit on the same data is kept)."""
+    h = hashlib.blake2b(s.flight.encode(), digest_size=16)
+    for a in (s.t, s.x, s.fresh):
+        h.update(np.ascontiguousarray(a).data)
+    return h.digest()
 
 
 def leave_one_date_out(segments: list) -> list[tuple[str, list, list]]:

@@ -44,18 +44,24 @@ scores: one of them is fitted and run, the others take its fit re-thresholded
 from __future__ import annotations
 
 import copy
-import hashlib
 import itertools
 import json
 import logging
-import math
 
 import numpy as np
 
 from alfa_bench.data import Sampled
 from alfa_bench.data.flight import parse_flight_name
 
-from .base import CalibrationError, Detector, Labelled, free_part, leave_one_date_out
+from .base import (
+    CalibrationError,
+    Detector,
+    Labelled,
+    clone,
+    free_part,
+    leave_one_date_out,
+    segment_digest,
+)
 
 __all__ = ["INNER_FITS", "NestedSelection", "held_out_right"]
 
@@ -65,14 +71,6 @@ log = logging.getLogger(__name__)
 #: :class:`~.base.CalibrationError` it could not be fitted with), by the selection's
 #: hyper-parameters, the candidate and the digest of its data
 INNER_FITS: dict[tuple, Detector | CalibrationError] = {}
-
-
-def _digest(s: Sampled) -> bytes:
-    """What identifies a segment's data: its flight, times, values and freshness."""
-    h = hashlib.blake2b(s.flight.encode(), digest_size=16)
-    for a in (s.t, s.x, s.fresh):
-        h.update(np.ascontiguousarray(a).data)
-    return h.digest()
 
 
 def _sharing(made: list[Detector]) -> list[list[int]]:
@@ -118,8 +116,9 @@ class NestedSelection(Detector):
     chosen_ : dict
         The winning values of the grid's hyper-parameters.
     inner_ : list of dict
-        Per candidate: its values, the held-out flights scored, how many were right, and
-        the training dates without which it could not be fitted.
+        Per candidate: its values, the held-out flights scored, how many were right,
+        their share (None where none was scored), and the training dates without which
+        it could not be fitted.
     base_ : Detector
         The base detector with ``chosen_``, fitted on every training flight.
     """
@@ -208,7 +207,7 @@ class NestedSelection(Detector):
         if len(folds) < 2:
             raise CalibrationError(f"nested selection needs training flights of two dates or "
                                    f"more; found {len(folds)}")
-        digest = {id(f): _digest(f.sampled) for f in segments}
+        digest = {id(f): segment_digest(f.sampled) for f in segments}
         candidates, groups = self.candidates(), _sharing(made)
         tally = [{"scored": 0, "right": 0, "unfit": []} for _ in made]
         for d, training, held in folds:
@@ -224,22 +223,25 @@ class NestedSelection(Detector):
                                  candidates[i], d, fits[i])
                         tally[i]["unfit"].append(d)
                 live = [i for i in group if not isinstance(fits[i], CalibrationError)]
-                for f in held if live else ():
-                    # one run for the group: its members differ in their thresholds only
-                    score, _ = fits[live[0]].run(f.sampled)
+                if not live:
+                    continue
+                # one run for the group (its members differ in their thresholds only), of
+                # every held-out flight at once
+                runs = fits[live[0]].run_many([(f.sampled, 0, None) for f in held])
+                for f, (score, _) in zip(held, runs, strict=True):
                     for i in live:
                         alarm = fits[i].alarms(score).any(axis=1)
                         first = float(f.t[np.argmax(alarm)]) if alarm.any() else None
                         tally[i]["right"] += held_out_right(first, f.onset_s, self.deadline_s)
                         tally[i]["scored"] += 1
         inner = [{"values": values, "scored": t["scored"], "right": t["right"],
-                  "share": t["right"] / t["scored"] if t["scored"] else math.nan,
+                  "share": t["right"] / t["scored"] if t["scored"] else None,
                   "unfit": t["unfit"]} for values, t in zip(candidates, tally, strict=True)]
         if not any(c["scored"] for c in inner):
             raise CalibrationError(f"nested selection of {self.detector!r}: no candidate could "
                                    "be fitted and scored on any training date")
-        best = max(range(len(inner)), key=lambda i: (np.nan_to_num(inner[i]["share"], nan=-1.0),
-                                                    -i))
+        best = max(range(len(inner)), key=lambda i: (
+            -1.0 if inner[i]["share"] is None else inner[i]["share"], -i))
         self.inner_ = inner
         self.chosen_ = inner[best]["values"]
         self.base_ = made[best].fit(self._free(segments))
@@ -262,7 +264,7 @@ class NestedSelection(Detector):
         shared = kept.get((selection, first, data)) if i != first else None
         try:
             if shared is None or isinstance(shared, CalibrationError):
-                kept[key] = copy.deepcopy(made[i].fit(self._free(training)))
+                kept[key] = clone(made[i]).fit(self._free(training))
             else:
                 det = copy.deepcopy(shared)
                 for name in type(det).threshold_params:

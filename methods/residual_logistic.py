@@ -94,8 +94,8 @@ from .base import (
 from .extremes import MaximaThresholds
 from .windows import window_steps
 
-__all__ = ["CHANNELS", "INPUTS", "ResidualLogistic", "ResidualLogisticPublished",
-           "best_accuracy_threshold"]
+__all__ = ["CHANNELS", "INPUTS", "WARMUP_S", "ResidualLogistic", "ResidualLogisticPublished",
+           "best_accuracy_threshold", "fit_residuals", "residual_features", "residuals"]
 
 #: standard gravity, m/s^2
 G = 9.80665
@@ -104,6 +104,9 @@ G = 9.80665
 INPUTS = ("accel_x", "accel_y", "roll_rate", "pitch_rate", "yaw_rate", "roll", "roll_cmd",
           "pitch", "pitch_cmd", "altitude_error", "airspeed_error", "nav_vel_north",
           "nav_vel_east", "nav_vel_down")
+
+#: the study's warm-up, s: no score, and no training step, before it
+WARMUP_S = 15.0
 
 #: the residual channels (1): target -> regressors (an intercept besides)
 CHANNELS = {"accel_x": ("altitude_error", "airspeed_error_ms", "pitch"),
@@ -144,6 +147,54 @@ def _trailing(z: np.ndarray, w: int) -> tuple[np.ndarray, np.ndarray]:
     for j in range(min(w, n)):
         dev[j:] += (z[:n - j] - mean[j:]) ** 2
     return mean, np.where(count > 1, np.sqrt(dev / np.maximum(count - 1, 1)), 0.0)
+
+
+def fit_residuals(x: np.ndarray) -> tuple[dict, dict]:
+    """The residual models (1) fitted by least squares on the nominal rows ``x`` (shape
+    (n, len(INPUTS))): per channel its coefficients and the spread of its residuals.
+
+    Raises
+    ------
+    CalibrationError
+        With fewer than 10 rows, or a channel whose residuals do not spread."""
+    nom = _quantities(x)
+    if nom["roll"].size < 10:
+        raise CalibrationError(f"residual models: {nom['roll'].size} nominal steps after "
+                               "the warm-up to fit them on")
+    weights, sigma = {}, {}
+    for y, r in CHANNELS.items():
+        X = _design(nom, r)
+        w, *_ = np.linalg.lstsq(X, nom[y], rcond=None)                   # (1)
+        weights[y] = w
+        sigma[y] = float(np.std(nom[y] - X @ w))
+        if not sigma[y] > 0:
+            raise CalibrationError(f"residual models: channel {y} has no nominal spread "
+                                   "to scale by")
+    return weights, sigma
+
+
+def residuals(x: np.ndarray, weights: dict, sigma: dict) -> np.ndarray:
+    """:math:`z` (2) of each row of ``x``, shape (n, 5). Each row's arithmetic is its
+    own (products summed in a fixed order, no matrix product whose kernel changes with
+    the rows), so that a step streamed alone gets the batch's residual bit for bit."""
+    q = _quantities(x)
+    out = []
+    for y, r in CHANNELS.items():
+        w = weights[y]
+        fit = np.full(q["roll"].size, w[0])
+        for name, wj in zip(r, w[1:], strict=True):
+            fit = fit + wj * q[name]
+        out.append((q[y] - fit) / sigma[y])                                     # (2)
+    return np.column_stack(out)
+
+
+def residual_features(z: np.ndarray, rate_hz: float) -> np.ndarray:
+    """The 25 features of each step of the residuals ``z`` (n, 5), over the steps there
+    are at the start: :math:`z`, :math:`|z|`, the 1 s and 3 s trailing means and the
+    1 s trailing standard deviation."""
+    mean_short, std_short = _trailing(z, window_steps(1.0, rate_hz))
+    mean_long, _ = _trailing(z, window_steps(3.0, rate_hz))
+    return np.hstack([z, np.abs(z), mean_short, mean_long, std_short])
 
 
 def best_accuracy_threshold(before: np.ndarray, after: np.ndarray,
@@ -187,21 +238,9 @@ class _ResidualClassifier:
     def _steps(self, seconds: float) -> int:
         return window_steps(seconds, self.rate_hz)
 
-    def _residuals(self, x: np.ndarray) -> np.ndarray:
-        """:math:`z` (2) of each row of ``x``, shape (n, 5)."""
-        q = _quantities(x)
-        return np.column_stack([(q[y] - _design(q, r) @ self.weights_[y]) / self.sigma_[y]
-                                for y, r in CHANNELS.items()])                   # (2)
-
-    def _features(self, z: np.ndarray) -> np.ndarray:
-        short, long_ = self._steps(1.0), self._steps(3.0)
-        mean_short, std_short = _trailing(z, short)
-        mean_long, _ = _trailing(z, long_)
-        return np.hstack([z, np.abs(z), mean_short, mean_long, std_short])
-
     def _logits(self, x: np.ndarray) -> np.ndarray:
-        f = (self._features(self._residuals(x)) - self.center_) / self.scale_
-        return f @ self.coef_ + self.intercept_
+        f = residual_features(residuals(x, self.weights_, self.sigma_), self.rate_hz)
+        return ((f - self.center_) / self.scale_) @ self.coef_ + self.intercept_
 
     def _lookback(self) -> int:
         """Steps before ``start`` a continued run reads again: the longest window and
@@ -222,20 +261,9 @@ class _ResidualClassifier:
             keep = late & ~(fault & seg.emergency_trajectory & (self.positives == "no_emr"))
             rows.append((seg.sampled.x, keep))
             labels.append(fault[keep])
-        nom = _quantities(np.vstack(nominal))
-        if nom["roll"].size < 10:
-            raise CalibrationError(f"residual logistic: {nom['roll'].size} nominal steps "
-                                   "after the warm-up to fit the residual models on")
-        self.weights_, self.sigma_ = {}, {}
-        for y, r in CHANNELS.items():
-            X = _design(nom, r)
-            w, *_ = np.linalg.lstsq(X, nom[y], rcond=None)               # (1)
-            self.weights_[y] = w
-            self.sigma_[y] = float(np.std(nom[y] - X @ w))
-            if not self.sigma_[y] > 0:
-                raise CalibrationError(f"residual logistic: channel {y} has no nominal "
-                                       "spread to scale by")
-        F = np.vstack([self._features(self._residuals(x))[keep] for x, keep in rows])
+        self.weights_, self.sigma_ = fit_residuals(np.vstack(nominal))
+        F = np.vstack([residual_features(residuals(x, self.weights_, self.sigma_),
+                                         self.rate_hz)[keep] for x, keep in rows])
         y = np.concatenate(labels)
         if np.unique(y).size < 2:
             raise CalibrationError("residual logistic: the training steps hold "
@@ -286,11 +314,10 @@ class _ResidualClassifier:
         return self
 
     def update(self, x: np.ndarray, fresh: np.ndarray) -> np.ndarray:
-        self.window_.append(self._residuals(np.asarray(x, float)[None, :])[0])
-        z = np.array(self.window_)
-        short = z[-self._steps(1.0):]
-        f = np.concatenate([z[-1], np.abs(z[-1]), short.mean(axis=0), z.mean(axis=0),
-                            short.std(axis=0, ddof=1) if len(short) > 1 else np.zeros(5)])
+        self.window_.append(residuals(np.asarray(x, float)[None, :], self.weights_,
+                                      self.sigma_)[0])
+        # the batch's features of the window's last step: the same sums in the same order
+        f = residual_features(np.array(self.window_), self.rate_hz)[-1]
         self.logits_.append(float(((f - self.center_) / self.scale_) @ self.coef_
                                   + self.intercept_))
         self.step_ += 1
@@ -345,7 +372,7 @@ class ResidualLogistic(_ResidualClassifier, MaximaThresholds, Detector):
         The logistic regression's :math:`\\boldsymbol\\beta` and :math:`b`.
     """
 
-    def __init__(self, positives="no_emr", C=0.1, persist=5, warmup_s=15.0, margin_s=1.0,
+    def __init__(self, positives="no_emr", C=0.1, persist=5, warmup_s=WARMUP_S, margin_s=1.0,
                  false_alarm=0.1, rate_hz=10.0):
         self.positives = positives
         self.C = C
@@ -388,7 +415,8 @@ class ResidualLogisticPublished(_ResidualClassifier, Detector):
         :meth:`pool_thresholds` draws from.
     """
 
-    def __init__(self, positives="all", C=0.1, persist=5, warmup_s=15.0, rate_hz=10.0):
+    def __init__(self, positives="all", C=0.1, persist=5, warmup_s=WARMUP_S,
+                 rate_hz=10.0):
         self.positives = positives
         self.C = C
         self.persist = persist

@@ -4,6 +4,7 @@ import shutil
 PAPER_INPUTS = [
     *rules.tables.output,
     *rules.per_flight.output,
+    *rules.features_learners.output,
     *rules.deadline.output,
     *rules.leakage.output,
     "results/tables/sweep.csv",

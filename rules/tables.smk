@@ -138,6 +138,32 @@ rule protocol_steps:
         "../scripts/protocol_steps.py"
 
 
+# The generic learners on raw windows (defaults, fair best) and on physical residuals
+rule features_learners:
+    input:
+        manifest="results/flights.csv",
+        per_flight="results/tables/per_flight.csv",
+        comparison="results/tables/comparison.csv",
+        # the nested runs' records, for the configuration each scored date chose
+        nested=[f"results/detections/{row['windows_best']}"
+                for row in config.get("features_learners", [])
+                if row.get("windows_best") in METHODS],
+    output:
+        csv="results/tables/features_learners.csv",
+        md="results/tables/features_learners.md",
+    params:
+        rows=config.get("features_learners", []),
+        primary=PRIMARY,
+        deadline_s=config["scoring"]["deadline_s"],
+        stable=config["stability"]["stable"],
+    resources:
+        **JOB_RESOURCES,
+    log:
+        "results/logs/features_learners.log",
+    script:
+        "../scripts/features_learners.py"
+
+
 rule runtime:
     input:
         manifest="results/flights.csv",

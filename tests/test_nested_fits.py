@@ -2,6 +2,7 @@
 since each fold fits a clone): the fit without dates {o, d} serves both the fold
 scoring o and the one scoring d, and changes nothing."""
 
+import json
 from pathlib import Path
 
 import yaml
@@ -74,3 +75,47 @@ def test_candidates_apart_in_thresholds_alone_share_one_fit(corpus_flights, monk
     assert held_dates >= 2 and rest == 0
     unfit = sum(len(c["unfit"]) for c in shared["inner"] if c["values"]["false_alarm"] == 0.05)
     assert together == 2 * held_dates + 1 + 2 * unfit < len(fits)
+
+
+def test_a_generic_model_is_fitted_once_per_candidate_and_dates(corpus_flights, monkeypatch):
+    """Nested selection of a PyOD model fits it on each set of dates inside the
+    out-of-sample maxima of several larger sets: each such fit is made once
+    (MODEL_FITS), and the choice, maxima and thresholds are those of fitting each anew."""
+    from alfa_bench.methods import outliers
+
+    spec = yaml.safe_load((REPO / "config/config.yaml").read_text())["methods"][
+        "pyod_knn_nested"]
+    grid = {"window_s": [1.0], "params": [{"n_neighbors": 3}, {"n_neighbors": 5}]}
+    flights = [f for f in corpus_flights.values() if f.fault is not None]
+    calls = []
+    real = outliers.PyODDetector._fit_estimator
+    monkeypatch.setattr(outliers.PyODDetector, "_fit_estimator",
+                        lambda self, e, X: calls.append(len(X)) or real(self, e, X))
+
+    def fitted() -> dict:
+        nested = make_detector(spec["detector"], {**spec["params"], "grid": grid})
+        INNER_FITS.clear()
+        outliers.MODEL_FITS.clear()
+        calls.clear()
+        return nested.fit(labelled_segments(nested, flights)).fitted()
+
+    kept = fitted()
+    made = len(calls)
+    monkeypatch.setattr(outliers, "MODEL_FITS_KEPT", 0)
+    assert fitted() == kept
+    assert 0 < made < len(calls)
+    assert not outliers.MODEL_FITS
+
+
+def test_a_candidate_never_fitted_is_recorded_unscored_in_valid_json(corpus_flights):
+    """A candidate that no training date can fit (here a window longer than any
+    flight) is named unfit on every date, with no share, and the record stays JSON."""
+    flights = [f for f in corpus_flights.values() if f.fault is not None]
+    nested = make_detector("nested_selection", {
+        "detector": "pyod", "params": {"model": "HBOS"},
+        "grid": {"window_s": [1.0, 1e5]}})
+    fitted = nested.fit(labelled_segments(nested, flights)).fitted()
+    never = fitted["inner"][1]
+    assert never["scored"] == 0 and never["share"] is None and never["unfit"]
+    assert fitted["chosen"] == {"window_s": 1.0}
+    json.dumps(fitted, allow_nan=False)

@@ -161,3 +161,38 @@ def test_the_published_rule_is_chosen_again_on_each_pool_of_its_training_flights
     # candidate, so half a unit above it
     before = [d.flight_maxima_[f][0] for f in fault_free_only]
     assert got[3, 0] == max(before) + 0.5
+
+
+def test_a_generic_model_reads_the_studys_features_learned_without_labels():
+    """On residual features an outlier model fits (1) on the fault-free rows after the
+    warm-up, reads the very features the logistic regression reads, and scores nothing
+    in the warm-up, in a batch or a stream."""
+    from alfa_bench.methods.outliers import PyODDetector
+    from alfa_bench.methods.residual_logistic import residual_features, residuals
+
+    free = [f.sampled for f in _corpus() if f.onset_s is None]
+    model = PyODDetector(model="HBOS", features="residuals", rate_hz=RATE).fit(free)
+    study = ResidualLogistic().fit(_corpus())
+    assert model.signals() == INPUTS
+    # the residual models come near the known coefficients of ay and r from these rows
+    assert model.weights_["accel_y"][0] == pytest.approx(0.2, abs=0.02)
+    assert model.weights_["yaw_rate"][1] == pytest.approx(0.9, abs=0.05)
+    s = free[0]
+    ours = model._features(s)
+    theirs = residual_features(residuals(s.x, model.weights_, model.sigma_), RATE)
+    warm = 150                                                    # 15 s at 10 Hz
+    assert np.isnan(ours[:warm]).all()
+    np.testing.assert_array_equal(ours[warm:], theirs[warm:])
+    assert ours.shape[1] == study.center_.size == 25
+    score = model.run(s)[0][:, 0]
+    assert np.isnan(score[:warm]).all() and np.isfinite(score[warm:]).all()
+    model.reset()
+    streamed = np.array([model.update(x, np.ones_like(x, bool))[0] for x in s.x])
+    np.testing.assert_array_equal(streamed, score)
+
+
+def test_an_unknown_feature_kind_is_refused_by_name():
+    from alfa_bench.methods.outliers import PyODDetector
+
+    with pytest.raises(ValueError, match="features must be one of"):
+        PyODDetector(features="raw").check_params()
