@@ -26,8 +26,8 @@ from alfa_bench.render import markdown
 
 from .per_flight import subset_counts
 
-__all__ = ["FEATURE_COLUMNS", "chosen_configurations", "features_learners",
-           "features_learners_markdown"]
+__all__ = ["COLUMNS", "FEATURE_COLUMNS", "chosen_configurations", "features_learners",
+           "features_learners_markdown", "features_learners_sections"]
 
 #: the config's keys of a row's runs, and their column headers
 FEATURE_COLUMNS = {"windows": "raw windows, defaults",
@@ -36,12 +36,13 @@ FEATURE_COLUMNS = {"windows": "raw windows, defaults",
 
 
 def _setting(values: dict) -> str:
-    """A nested selection's chosen values in words: ``window 5 s, n_neighbors 20``."""
-    parts = []
+    """A nested selection's chosen values in words, the window first:
+    ``window 5 s, n_neighbors 20``."""
+    parts = [f"window {values['window_s']:g} s"] if "window_s" in values else []
     for name, value in values.items():
         if name == "window_s":
-            parts.append(f"window {value:g} s")
-        elif isinstance(value, dict):
+            continue
+        if isinstance(value, dict):
             parts += [f"{k} {'all' if v is None else v}" for k, v in value.items()]
         else:
             parts.append(f"{name} {value}")
@@ -76,18 +77,28 @@ def features_learners(per_flight: pd.DataFrame, comparison: pd.DataFrame,
     for row in rows:
         for key, header in FEATURE_COLUMNS.items():
             run = row.get(key)
+            if run is None or run not in on_primary.index:
+                continue
             runs = per_flight[per_flight["method"] == run]
-            if run is None or runs.empty or run not in on_primary.index:
+            if runs.empty:
                 continue
             summary = on_primary.loc[run]
             beats = summary.get("beats_silence")
             out.append({"learner": row["learner"], "features": header, "run": run,
-                        "supervised": "supervised" in str(summary["calibration"]),
+                        # the comparison's words for a run whose fit read labels
+                        # (outputs.tables: "supervised (labelled flights)")
+                        "supervised": str(summary["calibration"]).startswith("supervised"),
                         "configurations": int(summary["configurations"]),
                         "chosen": chosen.get(run, ""),
                         **subset_counts(runs, members, stable),
                         "beats_silence": None if pd.isna(beats) else bool(beats)})
-    return pd.DataFrame(out)
+    return pd.DataFrame(out, columns=COLUMNS)
+
+
+#: the columns of :func:`features_learners`
+COLUMNS = ["learner", "features", "run", "supervised", "configurations", "chosen",
+           "faulty_flights", "detected", "early_alarms", "fault_free_flights",
+           "fault_free_alarmed", "stable_detections", "beats_silence"]
 
 
 def _cell(r: dict) -> str:
@@ -101,15 +112,21 @@ def _cell(r: dict) -> str:
     return text
 
 
-def features_learners_markdown(table: pd.DataFrame, primary: str, deadline_s: float) -> str:
-    """:func:`features_learners` as one Markdown table, learners by features."""
-    if table.empty:
-        return "None of the features-by-learners runs was scored.\n"
+def features_learners_sections(table: pd.DataFrame) -> list:
+    """:func:`features_learners` as one table section, learners by features (``-``
+    where a learner has no scored run of those features)."""
     learners = list(dict.fromkeys(table["learner"]))
     headers = [h for h in FEATURE_COLUMNS.values() if h in set(table["features"])]
     cells = {(r["learner"], r["features"]): _cell(r) for r in table.to_dict(orient="records")}
-    rows = [[learner, *(cells.get((learner, h), "not run") for h in headers)]
+    rows = [[learner, *(cells.get((learner, h), "-") for h in headers)]
             for learner in learners]
+    return [("Features by learners", ["learner", *headers], rows)]
+
+
+def features_learners_markdown(table: pd.DataFrame, primary: str, deadline_s: float) -> str:
+    """:func:`features_learners_sections` in Markdown, with what the cells count."""
+    if table.empty:
+        return "None of the features-by-learners runs was scored.\n"
     head = (f"Each learner on raw window features (with its library's defaults, and at "
             f"its fair best: window and main parameter chosen per scored date by nested "
             f"leave-one-date-out) and on the public study's 25 residual features. On "
@@ -117,5 +134,6 @@ def features_learners_markdown(table: pd.DataFrame, primary: str, deadline_s: fl
             "fault-free flights alarmed, faulty flights alarmed before onset, and whether "
             "the run's accuracy beats `silent`'s. The generic models learn from "
             "fault-free data alone, but at their fair best, which reads the training "
-            "flights' labels to choose; the logistic regression is supervised.\n\n")
-    return head + markdown([("Features by learners", ["learner", *headers], rows)])
+            "flights' labels to choose; the logistic regression is supervised. `-`: no "
+            "such run scored.\n\n")
+    return head + markdown(features_learners_sections(table))

@@ -27,6 +27,12 @@ distance is then zero; and flights of one date share its weather and trim), and 
 model that scores is fitted on all of them. A flight is scored in one batch call of the model
 (:meth:`OutlierModel.run`): a PyOD model costs milliseconds a call and microseconds a
 row.
+
+With ``features="residuals"`` the same model reads, instead of windows, a public
+study's 25 features of five physical residuals
+(:func:`~.residual_logistic.residual_features`), its residual models fitted on the
+fault-free training rows: what the features give, apart from the study's supervised
+learner (``results/tables/features_learners.md``).
 """
 
 from __future__ import annotations
@@ -36,6 +42,7 @@ import functools
 import importlib
 import importlib.metadata
 import inspect
+import json
 import math
 import re
 from collections import OrderedDict, deque
@@ -131,7 +138,8 @@ class OutlierModel(MaximaThresholds, Detector):
     Attributes
     ----------
     estimator_ : object
-        The fitted model.
+        The fitted model (for ECOD and COPOD the model as built, for its parameters:
+        :class:`PyODDetector`).
     center_, scale_ : ndarray
         The features' scaling, from the training rows.
     rows_ : int
@@ -166,7 +174,9 @@ class OutlierModel(MaximaThresholds, Detector):
         if not isinstance(self.model, str | None):
             return copy.deepcopy(self.model)
         cls = self._resolve(self._name())
-        params = dict(self.params or {})
+        # a copy of every value: a model may fit an estimator it was given in place
+        # (PyOD's LSCP its detector_list), which must not change the run's parameters
+        params = copy.deepcopy(dict(self.params or {}))
         seed = self._seed_name(cls)
         if seed is not None and params.get(seed) is None:
             params[seed] = 0
@@ -255,14 +265,16 @@ class OutlierModel(MaximaThresholds, Detector):
         return out
 
     def fit_model(self, segments: list[Sampled]) -> OutlierModel:
-        """Scale the training rows' features and fit the model on them (at most
+        r"""Scale the training rows' features and fit the model on them (at most
         ``max_rows``, evenly spaced).
 
         A fit on the same segments with the same hyper-parameters (the threshold's
-        aside) is taken from :data:`MODEL_FITS`: nested selection fits the model on two
-        dates inside the out-of-sample maxima of each third, and the fits are
-        deterministic (a seed is set). A model given as an estimator is always
-        fitted."""
+        aside) is taken from :data:`MODEL_FITS`: nested selection needs the model of a
+        candidate fitted without dates :math:`\{d, e\}` in the out-of-sample maxima of
+        its inner fit without :math:`d` and of the one without :math:`e` (and again in
+        later scored dates' folds), and the fits are deterministic (a seed is set). Only
+        a model named by its class with parameters of plain data is kept: an estimator
+        object may change after the fit."""
         key = self._fit_key(segments)
         if key is not None and key in MODEL_FITS:
             MODEL_FITS.move_to_end(key)
@@ -270,8 +282,9 @@ class OutlierModel(MaximaThresholds, Detector):
             return self
         self._fit_rows(segments)
         if key is not None:
-            MODEL_FITS[key] = {n: getattr(self, n) for n in self.model_state
-                               if hasattr(self, n)}
+            # in the order the fit set them, which a restored fit keeps: the fit's token
+            # digests its learned attributes in order
+            MODEL_FITS[key] = {n: v for n, v in vars(self).items() if n in self.model_state}
             while len(MODEL_FITS) > MODEL_FITS_KEPT:
                 MODEL_FITS.popitem(last=False)
         return self
@@ -280,10 +293,11 @@ class OutlierModel(MaximaThresholds, Detector):
     model_state = ("estimator_", "center_", "scale_", "rows_", "weights_", "sigma_")
 
     def _fit_key(self, segments: list[Sampled]) -> tuple | None:
-        if not isinstance(self.model, str | None):
-            return None
+        """What a fit on ``segments`` is kept under, or None where it may not be kept."""
         params = {k: v for k, v in self.get_params().items() if k not in self.threshold_params}
-        return (type(self).__qualname__, repr(sorted(params.items())),
+        if not _plain(params):
+            return None
+        return (type(self).__qualname__, json.dumps(params, sort_keys=True),
                 tuple(segment_digest(s) for s in segments))
 
     def _fit_rows(self, segments: list[Sampled]) -> None:
@@ -293,8 +307,9 @@ class OutlierModel(MaximaThresholds, Detector):
                 nominal[~np.isnan(nominal).any(axis=1)])
         X = np.vstack([f[~np.isnan(f).any(axis=1)] for f in map(self._features, segments)])
         if len(X) < 2:
-            raise CalibrationError(f"{self.channels()[0]}: {len(X)} training rows of full "
-                                   f"{self.window_s} s windows")
+            read = ("residual features after the warm-up" if self._residual() else
+                    f"full {self.window_s} s windows")
+            raise CalibrationError(f"{self.channels()[0]}: {len(X)} training rows of {read}")
         if len(X) > self.max_rows:
             X = X[np.linspace(0, len(X) - 1, self.max_rows).round().astype(int)]
         self.center_, self.scale_ = self._scaling(X)
@@ -387,6 +402,18 @@ class OutlierModel(MaximaThresholds, Detector):
 
     def probes(self) -> dict[str, float]:
         return {f"{self.channels()[0]}/score": getattr(self, "last_", math.nan)}
+
+
+def _plain(value) -> bool:
+    """Whether ``value`` is data alone (numbers, strings, None, and lists, tuples and
+    string-keyed dicts of them), which JSON writes whole."""
+    if value is None or isinstance(value, str | int | float | bool):
+        return True
+    if isinstance(value, list | tuple):
+        return all(map(_plain, value))
+    if isinstance(value, dict):
+        return all(isinstance(k, str) and _plain(v) for k, v in value.items())
+    return False
 
 
 def _params(estimator) -> dict:

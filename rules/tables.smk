@@ -151,6 +151,7 @@ rule features_learners:
     output:
         csv="results/tables/features_learners.csv",
         md="results/tables/features_learners.md",
+        tex="results/tables/features_learners.tex",
     params:
         rows=config.get("features_learners", []),
         primary=PRIMARY,

@@ -8,7 +8,7 @@ Measured in ``results/benchmarks/`` on the 6 flights of the synthetic corpus and
     m(n) = 360\\,\\mathrm{MB} + 7\\,\\mathrm{MB} \\cdot n, \\qquad
     t(n) = 5\\,\\mathrm{s} + 1.25\\,\\mathrm{s} \\cdot n
 
-for ``n`` flights (the largest: the nested selection of a PyOD model, 600 MB and 42 s
+for ``n`` flights (the largest: the nested selection of a PyOD model, 600 MB and 44 s
 on 40 flights). A job asks
 for twice :math:`m` and three times :math:`t`, at least 5 minutes, and a retried job for
 that again per attempt, so that a job SLURM stopped for memory or time gets more of it.
