@@ -2,21 +2,22 @@
 supervised detector learning from labelled flights, and a fold that lets one in stops
 the run."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
-import yaml
+from config_runs import CONFIG, one_run_per
 
 import alfa_bench.analysis.detections as detections
 from alfa_bench.analysis import detect_all, folds
 from alfa_bench.analysis.held_out import HeldOutError, group_labels
 from alfa_bench.methods import REGISTRY, Detector, Labelled, make_detector
 
-CONFIG = yaml.safe_load((Path(__file__).parent.parent / "config/config.yaml").read_text())
 CALIBRATION = {"group_by": "date", "margin_s": 1.0}
-CALIBRATED = sorted(n for n, spec in CONFIG["methods"].items()
-                    if REGISTRY[spec["detector"]].calibrated)
+# what reaches a run's fit depends on its detector (a nested selection's on its base
+# too) and its grouping, not on its other parameters: one run of each
+CALIBRATED = one_run_per(
+    lambda spec: (spec["detector"], (spec.get("params") or {}).get("detector"),
+                  repr(spec.get("calibration"))),
+    [n for n, spec in CONFIG["methods"].items() if REGISTRY[spec["detector"]].calibrated])
 
 
 class PeakRoll(Detector):
