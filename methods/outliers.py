@@ -183,11 +183,20 @@ class OutlierModel(MaximaThresholds, Detector):
         return cls(**params)
 
     def check_params(self) -> None:
-        """The features are known, and the model builds: its class resolves in the
-        library and takes ``params``."""
+        """The features are known (residual ones set no window or inputs, which they
+        would not read), and the model builds: its class resolves in the library and
+        takes ``params``."""
         if self.features not in FEATURE_KINDS:
             raise ValueError(f"features must be one of {list(FEATURE_KINDS)}, got "
                              f"{self.features!r}")
+        defaults = inspect.signature(OutlierModel).parameters
+        unread = [n for n, same in (("inputs", tuple(self.inputs) == defaults["inputs"].default),
+                                    ("window_s", self.window_s == defaults["window_s"].default))
+                  if self._residual() and not same]
+        if unread:
+            raise ValueError(f"features 'residuals' read the study's signals over its own "
+                             f"windows: {' and '.join(unread)} would not be read. What to "
+                             "do: leave them out, or read window features")
         try:
             self._build()
         except ImportError as e:

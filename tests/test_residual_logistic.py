@@ -196,3 +196,6 @@ def test_an_unknown_feature_kind_is_refused_by_name():
 
     with pytest.raises(ValueError, match="features must be one of"):
         PyODDetector(features="raw").check_params()
+    with pytest.raises(ValueError, match="window_s would not be read"):
+        PyODDetector(features="residuals", window_s=5.0).check_params()
+    PyODDetector(features="residuals").check_params()
