@@ -34,6 +34,11 @@ FEATURE_COLUMNS = {"windows": "raw windows, defaults",
                    "windows_best": "raw windows, at its fair best",
                    "residuals": "physical residuals"}
 
+#: the columns of :func:`features_learners`
+COLUMNS = ["learner", "features", "run", "supervised", "configurations", "chosen",
+           "faulty_flights", "detected", "early_alarms", "fault_free_flights",
+           "fault_free_alarmed", "stable_detections", "beats_silence"]
+
 
 def _setting(values: dict) -> str:
     """A nested selection's chosen values in words, the window first:
@@ -93,12 +98,6 @@ def features_learners(per_flight: pd.DataFrame, comparison: pd.DataFrame,
                         **subset_counts(runs, members, stable),
                         "beats_silence": None if pd.isna(beats) else bool(beats)})
     return pd.DataFrame(out, columns=COLUMNS)
-
-
-#: the columns of :func:`features_learners`
-COLUMNS = ["learner", "features", "run", "supervised", "configurations", "chosen",
-           "faulty_flights", "detected", "early_alarms", "fault_free_flights",
-           "fault_free_alarmed", "stable_detections", "beats_silence"]
 
 
 def _cell(r: dict) -> str:

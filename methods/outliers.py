@@ -65,6 +65,7 @@ from .base import (
 from .extremes import MaximaThresholds
 from .residual_logistic import INPUTS as RESIDUAL_INPUTS
 from .residual_logistic import (
+    LONGEST_WINDOW_S,
     WARMUP_S,
     fit_residuals,
     residual_features,
@@ -254,8 +255,9 @@ class OutlierModel(MaximaThresholds, Detector):
         return (f"{self.library}_{self._name()}".lower(),)
 
     def _width(self) -> int:
-        """Steps a step's features read: its window, or the residuals' longest (3 s)."""
-        return window_steps(3.0 if self._residual() else self.window_s, self.rate_hz)
+        """Steps a step's features read: its window, or the residuals' longest."""
+        return window_steps(LONGEST_WINDOW_S if self._residual() else self.window_s,
+                            self.rate_hz)
 
     def _warmup(self) -> int:
         return window_steps(WARMUP_S, self.rate_hz) if self._residual() else 0

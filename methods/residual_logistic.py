@@ -94,8 +94,9 @@ from .base import (
 from .extremes import MaximaThresholds
 from .windows import window_steps
 
-__all__ = ["CHANNELS", "INPUTS", "WARMUP_S", "ResidualLogistic", "ResidualLogisticPublished",
-           "best_accuracy_threshold", "fit_residuals", "residual_features", "residuals"]
+__all__ = ["CHANNELS", "INPUTS", "LONGEST_WINDOW_S", "WARMUP_S", "ResidualLogistic",
+           "ResidualLogisticPublished", "best_accuracy_threshold", "fit_residuals",
+           "residual_features", "residuals"]
 
 #: standard gravity, m/s^2
 G = 9.80665
@@ -107,6 +108,9 @@ INPUTS = ("accel_x", "accel_y", "roll_rate", "pitch_rate", "yaw_rate", "roll", "
 
 #: the study's warm-up, s: no score, and no training step, before it
 WARMUP_S = 15.0
+
+#: the longest trailing window of the features, s: what a step's features read
+LONGEST_WINDOW_S = 3.0
 
 #: the residual channels (1): target -> regressors (an intercept besides)
 CHANNELS = {"accel_x": ("altitude_error", "airspeed_error_ms", "pitch"),
@@ -193,7 +197,7 @@ def residual_features(z: np.ndarray, rate_hz: float) -> np.ndarray:
     are at the start: :math:`z`, :math:`|z|`, the 1 s and 3 s trailing means and the
     1 s trailing standard deviation."""
     mean_short, std_short = _trailing(z, window_steps(1.0, rate_hz))
-    mean_long, _ = _trailing(z, window_steps(3.0, rate_hz))
+    mean_long, _ = _trailing(z, window_steps(LONGEST_WINDOW_S, rate_hz))
     return np.hstack([z, np.abs(z), mean_short, mean_long, std_short])
 
 
@@ -245,7 +249,7 @@ class _ResidualClassifier:
     def _lookback(self) -> int:
         """Steps before ``start`` a continued run reads again: the longest window and
         the persistence."""
-        return self._steps(3.0) + self.persist
+        return self._steps(LONGEST_WINDOW_S) + self.persist
 
     def fit_model(self, segments: list[Labelled]) -> _ResidualClassifier:
         """Fit (1) on the nominal steps and the logistic regression on the steps after
@@ -308,7 +312,7 @@ class _ResidualClassifier:
 
     def reset(self) -> _ResidualClassifier:
         self._check_fitted("coef_")
-        self.window_ = deque(maxlen=self._steps(3.0))
+        self.window_ = deque(maxlen=self._steps(LONGEST_WINDOW_S))
         self.logits_ = deque(maxlen=self.persist)
         self.step_ = 0
         return self

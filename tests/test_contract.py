@@ -5,14 +5,11 @@ public (:mod:`alfa_bench.methods.contract`), so that a plugin's own tests run th
 ones (``examples/alfa-cusum``).
 """
 
-from pathlib import Path
-
-import yaml
+from config_runs import CONFIG
 
 from alfa_bench.methods import REGISTRY, make_detector
 from alfa_bench.methods.contract import parametrize_with_checks
 
-CONFIG = yaml.safe_load((Path(__file__).parent.parent / "config/config.yaml").read_text())
 RUNS = {name: (spec["detector"], spec.get("params", {})) for name, spec in
         CONFIG["methods"].items()}
 CASES = {f"registry:{n}": make_detector(n) for n in REGISTRY}

@@ -3,20 +3,16 @@ since each fold fits a clone): the fit without dates {o, d} serves both the fold
 scoring o and the one scoring d, and changes nothing."""
 
 import json
-from pathlib import Path
 
-import yaml
+from config_runs import CONFIG
 
 from alfa_bench.data.flight import parse_flight_name
 from alfa_bench.methods import labelled_segments, make_detector
 from alfa_bench.methods.nested_selection import INNER_FITS
 
-REPO = Path(__file__).resolve().parent.parent
-
 
 def _nested():
-    spec = yaml.safe_load((REPO / "config/config.yaml").read_text())["methods"][
-        "residual_bank_nested"]
+    spec = CONFIG["methods"]["residual_bank_nested"]
     params = {**spec["params"], "grid": {"false_alarm": [0.05, 0.2]}}
     return make_detector(spec["detector"], params)
 
@@ -83,8 +79,7 @@ def test_a_generic_model_is_fitted_once_per_candidate_and_dates(corpus_flights, 
     (MODEL_FITS), and the choice, maxima and thresholds are those of fitting each anew."""
     from alfa_bench.methods import outliers
 
-    spec = yaml.safe_load((REPO / "config/config.yaml").read_text())["methods"][
-        "pyod_knn_nested"]
+    spec = CONFIG["methods"]["pyod_knn_nested"]
     grid = {"window_s": [1.0], "params": [{"n_neighbors": 3}, {"n_neighbors": 5}]}
     flights = [f for f in corpus_flights.values() if f.fault is not None]
     calls = []

@@ -1,18 +1,15 @@
 """Checks on the real ALFA flights (skipped, and said so in the header, without ALFA_DIR)."""
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
-import yaml
+from config_runs import CONFIG
 
 from alfa_bench.analysis import detection_record
 from alfa_bench.data import build_manifest, load_flight, subset_flights
 from alfa_bench.methods import REGISTRY, make_detector, run_detector, training_segments
-
-CONFIG = yaml.safe_load((Path(__file__).parents[1] / "config/config.yaml").read_text())
 
 
 @pytest.fixture(scope="module")
