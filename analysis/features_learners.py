@@ -4,9 +4,11 @@ from what it reads.
 Each row of the config's ``features_learners`` names a learner and its runs: on raw
 window features with the library's defaults (``windows``), the same at its fair best,
 window and main parameter chosen by nested leave-one-date-out (``windows_best``), and
-on a public study's 25 physical-residual features (``residuals``). A generic model is
+on a public study's 25 physical-residual features (``residuals``), and on the union of
+the project's physical features, blocks and regularisation chosen by nested
+leave-one-date-out (``physical_best``: ``bench_logistic``). A generic model is
 unsupervised in every column but the fair best, which reads the training flights'
-labels to choose; the study's logistic regression is supervised. Read down a column
+labels to choose; the logistic regression is supervised. Read down a column
 for the learner, across a row for the features.
 
 Every cell counts what :func:`~.per_flight.subset_counts` counts on the headline
@@ -32,7 +34,8 @@ __all__ = ["COLUMNS", "FEATURE_COLUMNS", "chosen_configurations", "features_lear
 #: the config's keys of a row's runs, and their column headers
 FEATURE_COLUMNS = {"windows": "raw windows, defaults",
                    "windows_best": "raw windows, at its fair best",
-                   "residuals": "physical residuals"}
+                   "residuals": "physical residuals",
+                   "physical_best": "the project's physical features, at its fair best"}
 
 #: the columns of :func:`features_learners`
 COLUMNS = ["learner", "features", "run", "supervised", "configurations", "chosen",
@@ -49,6 +52,8 @@ def _setting(values: dict) -> str:
             continue
         if isinstance(value, dict):
             parts += [f"{k} {'all' if v is None else v}" for k, v in value.items()]
+        elif isinstance(value, list | tuple):
+            parts.append(f"{name} {'+'.join(map(str, value))}")
         else:
             parts.append(f"{name} {value}")
     return ", ".join(parts)
@@ -128,7 +133,9 @@ def features_learners_markdown(table: pd.DataFrame, primary: str, deadline_s: fl
         return "None of the features-by-learners runs was scored.\n"
     head = (f"Each learner on raw window features (with its library's defaults, and at "
             f"its fair best: window and main parameter chosen per scored date by nested "
-            f"leave-one-date-out) and on the public study's 25 residual features. On "
+            f"leave-one-date-out), on the public study's 25 residual features, and on "
+            f"the project's physical features (the study's, the residual bank's steps and "
+            f"the physical signatures; blocks and regularisation chosen the same way). On "
             f"`{primary}`, within {deadline_s:g} s of onset: faults detected in time, "
             "fault-free flights alarmed, faulty flights alarmed before onset, and whether "
             "the run's accuracy beats `silent`'s. The generic models learn from "

@@ -229,6 +229,12 @@ class Sampled:
         return Sampled(t=self.t[k:], x=self.x[k:], fresh=self.fresh[k:], names=self.names,
                        flight=self.flight)
 
+    def columns(self, names) -> Sampled:
+        """The signals ``names`` (each one of :attr:`names`), in that order."""
+        idx = [self.names.index(n) for n in names]
+        return Sampled(t=self.t, x=self.x[:, idx], fresh=self.fresh[:, idx], names=tuple(names),
+                       flight=self.flight)
+
 
 def series(flight: Flight, name: str) -> tuple[np.ndarray, np.ndarray]:
     """Signal ``name`` of ``flight`` at its topic's record times: ``(t, value)``."""

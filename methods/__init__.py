@@ -60,6 +60,7 @@ BUILTIN_ENTRIES = {
     "learned_fusion": "learned_fusion:LearnedFusion",
     "residual_logistic": "residual_logistic:ResidualLogistic",
     "residual_logistic_published": "residual_logistic:ResidualLogisticPublished",
+    "bench_logistic": "bench_logistic:BenchLogistic",
     "nested_selection": "nested_selection:NestedSelection",
     "coincidence": "coincidence:Coincidence",
     "emulation_oracle": "emulation_oracle:EmulationOracle",

@@ -54,10 +54,11 @@ import copy
 import functools
 import hashlib
 import inspect
+import json
 import logging
 import math
 from abc import ABC, abstractmethod
-from collections import deque
+from collections import OrderedDict, deque
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -779,13 +780,65 @@ def free_part(segment: Labelled, margin_s: float) -> Sampled:
     return segment.sampled.before(segment.onset_s - margin_s)
 
 
-def segment_digest(s: Sampled) -> bytes:
-    """What identifies a segment's data: its flight, times, values and freshness (a key
-    under which a fit on the same data is kept)."""
+def segment_digest(s: Sampled | Labelled) -> bytes:
+    """What identifies a segment's data: its flight, times, values and freshness, and a
+    labelled one's label (a key under which a fit on the same data is kept)."""
+    if isinstance(s, Labelled):
+        label = (s.onset_s, s.fault_class, s.emergency_trajectory)
+        return hashlib.blake2b(segment_digest(s.sampled) + repr(label).encode(),
+                               digest_size=16).digest()
     h = hashlib.blake2b(s.flight.encode(), digest_size=16)
     for a in (s.t, s.x, s.fresh):
         h.update(np.ascontiguousarray(a).data)
     return h.digest()
+
+
+#: the models fitted in this process (what :func:`kept_fit` keeps), by the detector's
+#: class, its hyper-parameters but the threshold's, and the digest of every training
+#: segment; the :data:`MODEL_FITS_KEPT` last used are kept
+MODEL_FITS: OrderedDict[tuple, dict] = OrderedDict()
+MODEL_FITS_KEPT = 256
+
+
+def plain_data(value) -> bool:
+    """Whether ``value`` is data alone (numbers, strings, None, and lists, tuples and
+    string-keyed dicts of them), which JSON writes whole."""
+    if value is None or isinstance(value, str | int | float | bool):
+        return True
+    if isinstance(value, list | tuple):
+        return all(map(plain_data, value))
+    if isinstance(value, dict):
+        return all(isinstance(k, str) and plain_data(v) for k, v in value.items())
+    return False
+
+
+def kept_fit(detector: Detector, segments: list, fit, state: tuple[str, ...]) -> None:
+    r"""``fit(segments)``, which sets ``detector``'s learned attributes ``state``, or
+    those attributes as a fit of the same class with the same hyper-parameters (the
+    threshold's aside) on the same data left them, kept in :data:`MODEL_FITS`.
+
+    Nested selection fits a candidate without the same dates again and again (the
+    out-of-sample maxima of its inner fit without :math:`d` and of the one without
+    :math:`e` both need the model without :math:`\{d, e\}`, and later scored dates'
+    folds again), and fits are deterministic. Only a detector whose hyper-parameters
+    are plain data (:func:`plain_data`) is kept: an estimator object may change after
+    the fit. A kept fit is restored in the order the fit set its attributes, as the
+    fit token (:func:`fit_token`) digests them in order."""
+    params = {k: v for k, v in detector.get_params().items()
+              if k not in detector.threshold_params}
+    key = None
+    if plain_data(params):
+        key = (type(detector).__qualname__, json.dumps(params, sort_keys=True),
+               tuple(map(segment_digest, segments)))
+    if key is not None and key in MODEL_FITS:
+        MODEL_FITS.move_to_end(key)
+        detector.__dict__.update(MODEL_FITS[key])
+        return
+    fit(segments)
+    if key is not None:
+        MODEL_FITS[key] = {n: v for n, v in vars(detector).items() if n in state}
+        while len(MODEL_FITS) > MODEL_FITS_KEPT:
+            MODEL_FITS.popitem(last=False)
 
 
 def leave_one_date_out(segments: list) -> list[tuple[str, list, list]]:

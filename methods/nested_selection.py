@@ -7,8 +7,10 @@ date, on labelled flights of the other dates only (:class:`~.base.Labelled`, so 
 ``supervised``: it reads their labels to score the candidates). Inside that fit, for
 each candidate :math:`c` and each training date :math:`d`, the base detector with
 :math:`c` is fitted on the fault-free data of the training dates other than
-:math:`d` (whole fault-free flights, the others up to onset less ``margin_s``) and run
-on the flights of :math:`d`. Each held-out flight counts as right when
+:math:`d` (whole fault-free flights, the others up to onset less ``margin_s``), or on
+their labelled flights if the base is supervised (a classifier's own inner
+leave-one-date-out then runs inside, on those dates alone), and run on the flights of
+:math:`d`. Each held-out flight counts as right when
 
 - a fault flight's first alarm lies in :math:`[\tau, \tau + D]` (``deadline_s``), the
   primary scoring rule;
@@ -19,9 +21,10 @@ training dates (a date without which :math:`c` cannot be fitted goes unscored, a
 named). Flights flown on an emergency trajectory are left out of the inner
 scores with ``score_emr`` False (the headline subset's rule; they still calibrate).
 The highest share wins, ties to the first candidate in grid order; the base detector
-with it is then fitted on the fault-free data of every training flight and scores the
-held-out date. So the scored date reaches neither the choice nor the fit, and the
-records say, per fold, which configuration scored and how many were tried
+with it is then fitted on every training flight (their fault-free data, or the
+flights labelled) and scores the held-out date. So the scored date reaches neither
+the choice nor the fit, and the records say, per fold, which configuration scored and
+how many were tried
 (:meth:`NestedSelection.fitted`).
 
 Every candidate must read the same signals and give the same channels; a grid that
@@ -179,9 +182,6 @@ class NestedSelection(Detector):
         if not candidates:
             raise ValueError("nested selection needs at least one candidate in its grid")
         made = [self._make(c) for c in candidates]
-        if made[0].supervised:
-            raise ValueError(f"the base detector {self.detector!r} is supervised: nested "
-                             "selection fits its candidates on fault-free data")
         for c, d in zip(candidates, made, strict=True):
             if (d.signals(), d.channels(), d.rate_hz) != (made[0].signals(), made[0].channels(),
                                                           made[0].rate_hz):
@@ -191,8 +191,12 @@ class NestedSelection(Detector):
 
     # -- fitting ------------------------------------------------------------------------
 
-    def _free(self, flights: list[Labelled]) -> list[Sampled]:
-        """The fault-free segments of ``flights``, as the workflow calibrates."""
+    def _training(self, base: Detector,
+                  flights: list[Labelled]) -> list[Sampled] | list[Labelled]:
+        """What ``base`` is fitted on of ``flights``: all of them, labelled, if it is
+        supervised; else their fault-free segments, as the workflow calibrates."""
+        if base.supervised:
+            return flights
         return [s for s in (free_part(f, self.margin_s) for f in flights) if s.t.size]
 
     def _scored(self, flight: Labelled) -> bool:
@@ -244,7 +248,7 @@ class NestedSelection(Detector):
             -1.0 if inner[i]["share"] is None else inner[i]["share"], -i))
         self.inner_ = inner
         self.chosen_ = inner[best]["values"]
-        self.base_ = made[best].fit(self._free(segments))
+        self.base_ = made[best].fit(self._training(made[best], segments))
         log.info("nested selection of %s: %s, %d of %d held-out flights right (of %d "
                  "candidates)", self.detector, self.chosen_, inner[best]["right"],
                  inner[best]["scored"], len(inner))
@@ -264,7 +268,7 @@ class NestedSelection(Detector):
         shared = kept.get((selection, first, data)) if i != first else None
         try:
             if shared is None or isinstance(shared, CalibrationError):
-                kept[key] = clone(made[i]).fit(self._free(training))
+                kept[key] = clone(made[i]).fit(self._training(made[i], training))
             else:
                 det = copy.deepcopy(shared)
                 for name in type(det).threshold_params:

@@ -42,10 +42,9 @@ import functools
 import importlib
 import importlib.metadata
 import inspect
-import json
 import math
 import re
-from collections import OrderedDict, deque
+from collections import deque
 from pathlib import Path
 
 import numpy as np
@@ -59,8 +58,8 @@ from .base import (
     StaleStateError,
     fit_token,
     json_ready,
+    kept_fit,
     leave_one_date_out,
-    segment_digest,
 )
 from .extremes import MaximaThresholds
 from .residual_logistic import INPUTS as RESIDUAL_INPUTS
@@ -73,7 +72,7 @@ from .residual_logistic import (
 )
 from .windows import window_steps
 
-__all__ = ["DEFAULT_SIGNALS", "FEATURES", "FEATURE_KINDS", "MODEL_FITS", "TRANSDUCTIVE",
+__all__ = ["DEFAULT_SIGNALS", "FEATURES", "FEATURE_KINDS", "TRANSDUCTIVE",
            "OutlierModel", "PyODDetector", "RiverDetector", "alone_ecdf_scores",
            "window_features"]
 
@@ -87,13 +86,6 @@ FEATURES = ("value", "mean", "std", "change")
 
 #: what a model can read: window features of the signals, or the study's residual ones
 FEATURE_KINDS = ("windows", "residuals")
-
-
-#: the models fitted in this process, what :meth:`OutlierModel.fit_model` learned, by
-#: the adapter, its hyper-parameters but the threshold's, and the digest of every
-#: training segment; the :data:`MODEL_FITS_KEPT` last used are kept
-MODEL_FITS: OrderedDict[tuple, dict] = OrderedDict()
-MODEL_FITS_KEPT = 256
 
 
 def window_features(window: np.ndarray) -> np.ndarray:
@@ -276,40 +268,15 @@ class OutlierModel(MaximaThresholds, Detector):
         return out
 
     def fit_model(self, segments: list[Sampled]) -> OutlierModel:
-        r"""Scale the training rows' features and fit the model on them (at most
-        ``max_rows``, evenly spaced).
-
-        A fit on the same segments with the same hyper-parameters (the threshold's
-        aside) is taken from :data:`MODEL_FITS`: nested selection needs the model of a
-        candidate fitted without dates :math:`\{d, e\}` in the out-of-sample maxima of
-        its inner fit without :math:`d` and of the one without :math:`e` (and again in
-        later scored dates' folds), and the fits are deterministic (a seed is set). Only
-        a model named by its class with parameters of plain data is kept: an estimator
-        object may change after the fit."""
-        key = self._fit_key(segments)
-        if key is not None and key in MODEL_FITS:
-            MODEL_FITS.move_to_end(key)
-            self.__dict__.update(MODEL_FITS[key])
-            return self
-        self._fit_rows(segments)
-        if key is not None:
-            # in the order the fit set them, which a restored fit keeps: the fit's token
-            # digests its learned attributes in order
-            MODEL_FITS[key] = {n: v for n, v in vars(self).items() if n in self.model_state}
-            while len(MODEL_FITS) > MODEL_FITS_KEPT:
-                MODEL_FITS.popitem(last=False)
+        """Scale the training rows' features and fit the model on them (at most
+        ``max_rows``, evenly spaced), or take the same fit from
+        :data:`~.base.MODEL_FITS` (:func:`~.base.kept_fit`; the fits are deterministic:
+        a seed is set)."""
+        kept_fit(self, segments, self._fit_rows, self.model_state)
         return self
 
     #: what :meth:`fit_model` learns
     model_state = ("estimator_", "center_", "scale_", "rows_", "weights_", "sigma_")
-
-    def _fit_key(self, segments: list[Sampled]) -> tuple | None:
-        """What a fit on ``segments`` is kept under, or None where it may not be kept."""
-        params = {k: v for k, v in self.get_params().items() if k not in self.threshold_params}
-        if not _plain(params):
-            return None
-        return (type(self).__qualname__, json.dumps(params, sort_keys=True),
-                tuple(segment_digest(s) for s in segments))
 
     def _fit_rows(self, segments: list[Sampled]) -> None:
         if self._residual():
@@ -413,18 +380,6 @@ class OutlierModel(MaximaThresholds, Detector):
 
     def probes(self) -> dict[str, float]:
         return {f"{self.channels()[0]}/score": getattr(self, "last_", math.nan)}
-
-
-def _plain(value) -> bool:
-    """Whether ``value`` is data alone (numbers, strings, None, and lists, tuples and
-    string-keyed dicts of them), which JSON writes whole."""
-    if value is None or isinstance(value, str | int | float | bool):
-        return True
-    if isinstance(value, list | tuple):
-        return all(map(_plain, value))
-    if isinstance(value, dict):
-        return all(isinstance(k, str) and _plain(v) for k, v in value.items())
-    return False
 
 
 def _params(estimator) -> dict:

@@ -78,7 +78,9 @@ def _sums(values: np.ndarray, n: int) -> np.ndarray:
 
 
 def _gain(rate: np.ndarray, error: np.ndarray, have: np.ndarray, n: int) -> np.ndarray:
-    """The window's least-squares gain of ``rate`` on ``-error`` (module docstring)."""
+    """The window's least-squares gain of ``rate`` on ``-error`` (module docstring), over
+    the steps ``have`` marks where both are finite: one NaN would spoil every later sum."""
+    have = have & np.isfinite(rate) & np.isfinite(error)
     num = _sums(np.where(have, -rate * error, 0.0), n)
     den = _sums(np.where(have, error ** 2 + _E0 ** 2, 0.0), n)
     with np.errstate(invalid="ignore", divide="ignore"):

@@ -203,7 +203,7 @@ class ResidualBank(MaximaThresholds, Detector):
             phi = np.full((n, 1 + k * len(lags)), np.nan)
             phi[:, 0] = 1.0
             for li, lag in enumerate(lags):
-                phi[lag:, 1 + li * k: 1 + (li + 1) * k] = z[:n - lag, j:j + k]
+                phi[lag:, 1 + li * k: 1 + (li + 1) * k] = z[:max(n - lag, 0), j:j + k]
             phi[:max(lags)] = np.nan
             out.append(phi)
             j += k

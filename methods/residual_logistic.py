@@ -242,8 +242,19 @@ class _ResidualClassifier:
     def _steps(self, seconds: float) -> int:
         return window_steps(seconds, self.rate_hz)
 
-    def _logits(self, x: np.ndarray) -> np.ndarray:
-        f = residual_features(residuals(x, self.weights_, self.sigma_), self.rate_hz)
+    def _fit_features(self, free: list[Sampled]) -> None:
+        """Fit what the features read on the training flights' parts before onset
+        (``free``): the residual models (1), on their steps after the warm-up."""
+        warm = self._steps(self.warmup_s)
+        self.weights_, self.sigma_ = fit_residuals(np.vstack([s.x[warm:] for s in free]))
+
+    def _features(self, s: Sampled, first_step: int = 0) -> np.ndarray:
+        """The features of every step of ``s`` (which starts at step ``first_step`` of
+        its flight), shape (n, features)."""
+        return residual_features(residuals(s.x, self.weights_, self.sigma_), self.rate_hz)
+
+    def _logits(self, s: Sampled, first_step: int = 0) -> np.ndarray:
+        f = self._features(s, first_step)
         return ((f - self.center_) / self.scale_) @ self.coef_ + self.intercept_
 
     def _lookback(self) -> int:
@@ -257,17 +268,16 @@ class _ResidualClassifier:
         if self.positives not in ("no_emr", "all"):
             raise ValueError(f"positives must be 'no_emr' or 'all', got {self.positives!r}")
         warm = self._steps(self.warmup_s)
-        nominal, rows, labels = [], [], []
+        free, rows, labels = [], [], []
         for seg in segments:
             t, late = seg.t, np.arange(seg.t.size) >= warm
             fault = np.zeros(t.size, bool) if seg.onset_s is None else t >= seg.onset_s
-            nominal.append(seg.sampled.x[late & ~fault])
+            free.append(seg.sampled if seg.onset_s is None else seg.sampled.before(seg.onset_s))
             keep = late & ~(fault & seg.emergency_trajectory & (self.positives == "no_emr"))
-            rows.append((seg.sampled.x, keep))
+            rows.append((seg.sampled, keep))
             labels.append(fault[keep])
-        self.weights_, self.sigma_ = fit_residuals(np.vstack(nominal))
-        F = np.vstack([residual_features(residuals(x, self.weights_, self.sigma_),
-                                         self.rate_hz)[keep] for x, keep in rows])
+        self._fit_features(free)
+        F = np.vstack([self._features(s)[keep] for s, keep in rows])
         y = np.concatenate(labels)
         if np.unique(y).size < 2:
             raise CalibrationError("residual logistic: the training steps hold "
@@ -293,7 +303,7 @@ class _ResidualClassifier:
             raise StaleStateError(f"{type(self).__name__}: the state to continue from was "
                                   "taken under another fit or other parameters")
         first = max(start - self._lookback(), 0)
-        logit = self._logits(s.x[first:])
+        logit = self._logits(s.since(first), first)
         n = self.persist
         low = np.full(logit.size, np.nan)
         if logit.size >= n:

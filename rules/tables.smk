@@ -145,9 +145,9 @@ rule features_learners:
         per_flight="results/tables/per_flight.csv",
         comparison="results/tables/comparison.csv",
         # the nested runs' records, for the configuration each scored date chose
-        nested=[f"results/detections/{row['windows_best']}"
+        nested=[f"results/detections/{row[key]}"
                 for row in config.get("features_learners", [])
-                if row.get("windows_best") in METHODS],
+                for key in ("windows_best", "physical_best") if row.get(key) in METHODS],
     output:
         csv="results/tables/features_learners.csv",
         md="results/tables/features_learners.md",

@@ -145,11 +145,11 @@ def test_a_kept_fit_is_the_fresh_fit_token_and_all(corpus_flights):
     """A model taken from MODEL_FITS leaves the detector as a fresh fit does: the same
     learned attributes in the same order, so the same fit token (a state taken under
     one is continued under the other)."""
-    from alfa_bench.methods import outliers
+    from alfa_bench.methods import base
 
     flights = [f for f in corpus_flights.values() if f.fault is not None]
     segments = training_segments(make_detector("pyod", {"model": "HBOS"}), flights, 1.0)
-    outliers.MODEL_FITS.clear()
+    base.MODEL_FITS.clear()
     fresh = make_detector("pyod", {"model": "HBOS"}).fit(segments)
     kept = make_detector("pyod", {"model": "HBOS"}).fit(segments)       # every fit kept
     assert list(vars(kept)) == list(vars(fresh))
@@ -162,12 +162,12 @@ def test_a_model_built_from_estimator_objects_is_neither_kept_nor_changed(corpus
     kept one could change after it was kept)."""
     from pyod.models.lof import LOF
 
-    from alfa_bench.methods import outliers
+    from alfa_bench.methods import base
 
     given = [LOF(n_neighbors=5), LOF(n_neighbors=10)]
     d = PyODDetector(model="LSCP", params={"detector_list": given})
     flights = [f for f in corpus_flights.values() if f.fault is not None]
-    outliers.MODEL_FITS.clear()
+    base.MODEL_FITS.clear()
     d.fit(training_segments(d, flights, 1.0))
-    assert not outliers.MODEL_FITS
+    assert not base.MODEL_FITS
     assert not any(hasattr(g, "decision_scores_") for g in given)

@@ -1,0 +1,83 @@
+"""The project's own supervised entry (methods/bench_logistic.py): its blocks, its fits
+kept across a nested selection, and the selection's inner fits on labelled flights of
+the inner training dates only."""
+
+import numpy as np
+import pytest
+from config_runs import CONFIG
+
+from alfa_bench.data import Sampled
+from alfa_bench.data.flight import parse_flight_name
+from alfa_bench.methods import base, labelled_segments, make_detector, physics
+from alfa_bench.methods.bench_logistic import BenchLogistic
+from alfa_bench.methods.nested_selection import INNER_FITS
+
+
+def _date(flight: str) -> str:
+    return str(parse_flight_name(flight)["date"])
+
+
+def test_the_nested_run_fits_each_candidate_on_labelled_flights_of_other_dates(
+        corpus_flights, monkeypatch):
+    """Nested selection over a supervised base gives each candidate the labelled flights
+    of the inner training dates, never one of the date it is scored on, and the chosen
+    classifier all the training flights."""
+    spec = CONFIG["methods"]["bench_logistic"]
+    grid = {"features": [["study"], ["study", "physics"]], "C": [0.1]}
+    nested = make_detector(spec["detector"], {**spec["params"], "grid": grid})
+    seen = []
+    real = BenchLogistic.fit_model
+    monkeypatch.setattr(BenchLogistic, "fit_model",
+                        lambda self, segs: seen.append(segs) or real(self, segs))
+    flights = list(corpus_flights.values())
+    training = labelled_segments(nested, flights)
+    INNER_FITS.clear()
+    base.MODEL_FITS.clear()
+    nested.fit(training)
+    assert all(isinstance(s, base.Labelled) for segs in seen for s in segs)
+    assert any(s.onset_s is not None for segs in seen for s in segs)
+    dates = {_date(f.flight) for f in training}
+    # every inner fit misses a training date at least; the last fit has them all
+    assert all({_date(s.flight) for s in segs} < dates for segs in seen[:-1])
+    assert {s.flight for s in seen[-1]} == {f.flight for f in training}
+    inner = nested.fitted()["inner"]
+    assert [c["values"]["features"] for c in inner] == grid["features"]
+    assert all(c["scored"] > 0 for c in inner)
+
+
+def test_a_kept_classifier_fit_is_the_fresh_fit(corpus_flights):
+    """A fit taken from MODEL_FITS is the fresh fit, token and all; a flight labelled
+    otherwise is other data, not the same fit."""
+    d = BenchLogistic(features=("study", "bank", "physics"))
+    segments = labelled_segments(d, list(corpus_flights.values()))
+    base.MODEL_FITS.clear()
+    fresh = BenchLogistic(features=("study", "bank", "physics")).fit(segments)
+    kept = BenchLogistic(features=("study", "bank", "physics")).fit(segments)
+    assert list(vars(kept)) == list(vars(fresh))
+    assert kept.snapshot() == fresh.snapshot()
+    faulty = next(i for i, s in enumerate(segments) if s.onset_s is not None)
+    moved = list(segments)
+    moved[faulty] = base.Labelled(segments[faulty].sampled, segments[faulty].onset_s + 1.0,
+                                  segments[faulty].fault_class)
+    assert base.segment_digest(moved[faulty]) != base.segment_digest(segments[faulty])
+
+
+@pytest.mark.parametrize("features", [("bank",), ("study", "study"), ("study", "wind")])
+def test_blocks_must_be_distinct_known_and_hold_the_study(features):
+    with pytest.raises(ValueError, match="distinct blocks"):
+        BenchLogistic(features=features)._blocks()
+
+
+def test_a_nan_row_does_not_spoil_the_attitude_gains_after_it():
+    """A gain sums its window's products: a NaN row at a fresh step once made every
+    later sum NaN in a whole-flight run, while a stream forgets it (seen in the
+    classifier's streaming check)."""
+    n = 600
+    rng = np.random.default_rng(0)
+    x = rng.normal(size=(n, len(physics.SIGNALS_READ)))
+    x[300] = np.nan
+    s = Sampled(t=np.arange(n) / physics.RATE_HZ, x=x, fresh=np.ones_like(x, bool),
+                names=physics.SIGNALS_READ)
+    feats = physics.features_of(s)
+    for name in ("roll_rate_gain_drop", "pitch_rate_gain_drop", "roll_asymmetry"):
+        assert np.isfinite(feats[name][-50:]).all(), name
