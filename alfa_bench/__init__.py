@@ -30,6 +30,7 @@ _MODULES = {
     **dict.fromkeys(["Corpus", "Result", "compare", "evaluate", "load_corpus", "user_cache"],
                     "alfa_bench.evaluation"),
     **dict.fromkeys(["ConfigError", "load_config"], "alfa_bench.config"),
+    **dict.fromkeys(["fit_run", "load_model", "save_run"], "alfa_bench.models"),
     **dict.fromkeys(["CalibrationError", "Detector", "MaximaThresholds", "NotFittedError",
                      "make_detector"], "alfa_bench.methods"),
 }

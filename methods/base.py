@@ -161,6 +161,17 @@ def _digest(*values) -> str:
     return h.hexdigest()
 
 
+def _fit_state(detector: Detector) -> dict:
+    return {n: v for n, v in learned_state(detector).items()
+            if n not in ("fit_digest_", "fit_report_")}
+
+
+def learned_digest(detector: Detector) -> str:
+    """A digest, by value, of every attribute ``detector`` has learned (but the digest
+    and report its fit leaves): its ``fit_digest_`` right after a fit."""
+    return _digest(_fit_state(detector))
+
+
 def fit_token(detector: Detector) -> str:
     """What a running state belongs to: a digest of the detector's hyper-parameters and
     of every attribute its last :meth:`~Detector.fit` (or
@@ -235,11 +246,9 @@ def _sealed(method, forget: bool):
             out = method(self, *args, **kwargs)
         finally:
             _FITTING.discard(id(self))
-        learned = {n: v for n, v in learned_state(self).items()
-                   if n not in ("fit_digest_", "fit_report_")}
         if self.calibrated and type(self).fitted is Detector.fitted:
-            self.fit_report_ = json_ready(learned)
-        self.fit_digest_ = _digest(learned)
+            self.fit_report_ = json_ready(_fit_state(self))
+        self.fit_digest_ = learned_digest(self)
         return out
 
     sealed.seals_the_fit = True

@@ -1,0 +1,208 @@
+"""A fitted detector in one file that loads without running any code from it.
+
+A model file is a NumPy ``.npz`` archive (a zip) of plain arrays: ``model.json``, a
+JSON document as bytes, and ``a0``, ``a1``, ... the numeric arrays it refers to. The
+document holds the format's name and version, the package version that wrote it, the
+run's name and config, the digests of the data it was fitted on, the signals the
+detector reads (at which grid rate, and whether one is written by ALFA's fault
+emulation), its registry name and hyper-parameters, and its learned state (every
+attribute ending in ``_``, :func:`~.base.learned_state`) encoded as
+
+- numbers, strings, booleans and None as JSON, a non-finite float as
+  ``{"float": "nan"}``;
+- lists as JSON lists, tuples as ``{"tuple": [...]}``, string-keyed dicts as
+  ``{"dict": {...}}``, other keys as ``{"pairs": [[key, value], ...]}``;
+- a numeric array or NumPy scalar as ``{"array": i}`` (``a<i>`` in the archive);
+- a detector held by another (a nested selection's base, a classifier's residual bank)
+  as ``{"detector": name, "params": ..., "state": ...}``, built again from the
+  registry.
+
+Anything else (a library's estimator object, an object array) is refused when saving,
+naming the attribute. Loading reads the archive with ``allow_pickle=False``, checks a
+SHA-256 over the document and every array, the format and the package version, builds
+the detector from the registry by name, sets its state and checks that its fit token
+is the one saved: the detector is the fitted one, by value, or the load fails.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import math
+import os
+import zipfile
+from collections import deque
+from pathlib import Path
+
+import numpy as np
+
+from alfa_bench.data import reads_actuators
+
+from .base import Detector, fit_token, learned_digest, learned_state
+
+__all__ = ["FORMAT", "FORMAT_VERSION", "ModelFileError", "load_model", "save_model"]
+
+#: the format's name, in every file
+FORMAT = "alfa-bench model"
+#: the version of the encoding (module docstring)
+FORMAT_VERSION = 1
+
+
+class ModelFileError(ValueError):
+    """A model file that cannot be written or loaded: the message names the file and what
+    is wrong."""
+
+
+def _version() -> str:
+    from alfa_bench import __version__
+
+    return __version__
+
+
+def _encode(value, arrays: list[np.ndarray], where: str):
+    from . import detector_name
+
+    if isinstance(value, Detector):
+        return {"detector": detector_name(value), "params": _encode(value.get_params(), arrays,
+                                                                    f"{where}.params"),
+                "state": _encode(learned_state(value), arrays, f"{where}.state")}
+    if isinstance(value, np.ndarray | np.generic):
+        a = np.asarray(value)
+        if a.dtype.hasobject or a.dtype.kind not in "biufc":
+            raise ModelFileError(f"{where}: an array of {a.dtype} cannot be saved")
+        arrays.append(a)
+        return {"array": len(arrays) - 1}
+    if isinstance(value, bool) or value is None or isinstance(value, str | int):
+        return value
+    if isinstance(value, float):
+        return value if math.isfinite(value) else {"float": repr(value)}
+    if isinstance(value, list):
+        return [_encode(v, arrays, f"{where}[{i}]") for i, v in enumerate(value)]
+    if isinstance(value, tuple):
+        return {"tuple": [_encode(v, arrays, f"{where}[{i}]") for i, v in enumerate(value)]}
+    if isinstance(value, deque):
+        return {"deque": [_encode(v, arrays, f"{where}[{i}]") for i, v in enumerate(value)],
+                "maxlen": value.maxlen}
+    if isinstance(value, dict):
+        if all(isinstance(k, str) for k in value):
+            return {"dict": {k: _encode(v, arrays, f"{where}.{k}") for k, v in value.items()}}
+        return {"pairs": [[_encode(k, arrays, f"{where} key"),
+                           _encode(v, arrays, f"{where}[{k!r}]")] for k, v in value.items()]}
+    raise ModelFileError(f"{where}: a {type(value).__name__} cannot be saved as arrays and "
+                         "JSON")
+
+
+def _decode(value, arrays: dict[str, np.ndarray]):
+    if isinstance(value, list):
+        return [_decode(v, arrays) for v in value]
+    if not isinstance(value, dict):
+        return value
+    if "array" in value:
+        a = arrays[f"a{value['array']}"]
+        return a[()] if a.ndim == 0 else a
+    if "float" in value:
+        return float(value["float"])
+    if "tuple" in value:
+        return tuple(_decode(v, arrays) for v in value["tuple"])
+    if "deque" in value:
+        return deque((_decode(v, arrays) for v in value["deque"]), maxlen=value["maxlen"])
+    if "dict" in value:
+        return {k: _decode(v, arrays) for k, v in value["dict"].items()}
+    if "pairs" in value:
+        return {_decode(k, arrays): _decode(v, arrays) for k, v in value["pairs"]}
+    if "detector" in value:
+        return _build(value, arrays)
+    raise ValueError(f"unknown encoding {sorted(value)}")
+
+
+def _build(spec: dict, arrays: dict[str, np.ndarray]) -> Detector:
+    from . import make_detector
+
+    detector = make_detector(spec["detector"], _decode(spec["params"], arrays))
+    for name, v in _decode(spec["state"], arrays).items():
+        setattr(detector, name, v)
+    return detector
+
+
+def _digest(document: bytes, arrays: dict[str, np.ndarray]) -> str:
+    h = hashlib.sha256(document)
+    for name in sorted(arrays):
+        a = np.ascontiguousarray(arrays[name])
+        h.update(f"{name}<{a.dtype.str}{a.shape}>".encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def save_model(detector: Detector, path: str | os.PathLike, *, run: str,
+               config: dict | None = None, data: dict | None = None) -> Path:
+    """Write the fitted ``detector`` to ``path``: the run's name, its ``config`` spec and
+    the ``data`` it was fitted on (flight -> SHA-256) beside its state (module
+    docstring). Raises :class:`ModelFileError` naming an attribute that cannot be saved."""
+    detector._check_fitted("fit_digest_")
+    if learned_digest(detector) != detector.fit_digest_:
+        raise ModelFileError(f"{type(detector).__name__} has run or changed since its fit: "
+                             "save it right after fit()")
+    arrays: list[np.ndarray] = []
+    body = {"format": FORMAT, "format_version": FORMAT_VERSION, "version": _version(),
+            "run": run, "config": config or {}, "data": data or {},
+            "signals": list(detector.signals()), "rate_hz": detector.rate_hz,
+            "reads_actuators": reads_actuators(detector.signals()),
+            "fit_token": fit_token(detector),
+            "model": _encode(detector, arrays, type(detector).__name__)}
+    # keys in their order: a restored state must be set in the order the fit set it
+    document = json.dumps(body, allow_nan=False).encode()
+    named = {f"a{i}": a for i, a in enumerate(arrays)}
+    digest = _digest(document, named)
+    path = Path(path)
+    buffer = io.BytesIO()
+    np.savez_compressed(buffer, **named, **{"model.json": np.frombuffer(document, np.uint8),
+                                             "sha256": np.frombuffer(digest.encode(), np.uint8)})
+    path.write_bytes(buffer.getvalue())
+    return path
+
+
+def load_model(path: str | os.PathLike) -> tuple[Detector, dict]:
+    """The fitted detector of the model file ``path``, and what the file says of it (its
+    run, config, data, version). Nothing in the file is run: arrays are read without
+    pickle, the detector is built by its registry name.
+
+    Raises
+    ------
+    ModelFileError
+        Naming the file: not a model file, damaged or altered (its SHA-256), of another
+        format or package version, of a detector this installation does not know, or a
+        state that does not give the saved fit."""
+    path = Path(path)
+    try:
+        with np.load(path, allow_pickle=False) as archive:
+            arrays = {name: archive[name] for name in archive.files}
+    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as e:
+        raise ModelFileError(f"{path}: not a readable model file ({e})") from None
+    try:
+        document = arrays.pop("model.json").tobytes()
+        saved = arrays.pop("sha256").tobytes().decode()
+    except (KeyError, UnicodeDecodeError):
+        raise ModelFileError(f"{path}: not an alfa-bench model file") from None
+    if _digest(document, arrays) != saved:
+        raise ModelFileError(f"{path}: its content does not match its SHA-256: the file is "
+                             "damaged or was altered")
+    body = json.loads(document)
+    if body.get("format") != FORMAT or body.get("format_version") != FORMAT_VERSION:
+        raise ModelFileError(f"{path}: format {body.get('format')!r} version "
+                             f"{body.get('format_version')!r}; this reads {FORMAT!r} "
+                             f"version {FORMAT_VERSION}")
+    if body["version"] != _version():
+        raise ModelFileError(f"{path}: written by alfa-bench {body['version']}, this is "
+                             f"{_version()}: fit the run again with this version")
+    try:
+        detector = _build(body["model"], arrays)
+    except KeyError as e:
+        raise ModelFileError(f"{path}: detector {body['model'].get('detector')!r} is not "
+                             f"registered here ({e})") from None
+    except (TypeError, ValueError) as e:
+        raise ModelFileError(f"{path}: its detector cannot be built ({e})") from None
+    if learned_digest(detector) != detector.fit_digest_ or fit_token(detector) != body[
+            "fit_token"]:
+        raise ModelFileError(f"{path}: the state loaded does not give the fit saved")
+    return detector, {k: v for k, v in body.items() if k != "model"}
