@@ -20,7 +20,9 @@ and :math:`c` scores the share of held-out flights it gets right, pooled over th
 training dates (a date without which :math:`c` cannot be fitted goes unscored, and is
 named). Flights flown on an emergency trajectory are left out of the inner
 scores with ``score_emr`` False (the headline subset's rule; they still calibrate).
-The highest share wins, ties to the first candidate in grid order; the base detector
+The highest share wins, ties to the first candidate in grid order (which also wins,
+said so in the record and the log, where no candidate could be scored: too few dates or
+flights to fit any without one); the base detector
 with it is then fitted on every training flight (their fault-free data, or the
 flights labelled) and scores the held-out date. So the scored date reaches neither
 the choice nor the fit, and the records say, per fold, which configuration scored and
@@ -118,6 +120,8 @@ class NestedSelection(Detector):
     ----------
     chosen_ : dict
         The winning values of the grid's hyper-parameters.
+    chosen_by_ : str
+        How: by the inner scores, or by grid order where none could be scored.
     inner_ : list of dict
         Per candidate: its values, the held-out flights scored, how many were right,
         their share (None where none was scored), and the training dates without which
@@ -241,12 +245,15 @@ class NestedSelection(Detector):
         inner = [{"values": values, "scored": t["scored"], "right": t["right"],
                   "share": t["right"] / t["scored"] if t["scored"] else None,
                   "unfit": t["unfit"]} for values, t in zip(candidates, tally, strict=True)]
-        if not any(c["scored"] for c in inner):
-            raise CalibrationError(f"nested selection of {self.detector!r}: no candidate could "
-                                   "be fitted and scored on any training date")
         best = max(range(len(inner)), key=lambda i: (
             -1.0 if inner[i]["share"] is None else inner[i]["share"], -i))
+        if not any(c["scored"] for c in inner):
+            log.warning("nested selection of %s: no candidate could be fitted and scored on "
+                        "any training date (%s); the first of the grid is taken",
+                        self.detector, sorted({u for c in inner for u in c["unfit"]}))
         self.inner_ = inner
+        self.chosen_by_ = ("inner leave-one-date-out" if any(c["scored"] for c in inner)
+                           else "grid order: no candidate could be scored without a date")
         self.chosen_ = inner[best]["values"]
         self.base_ = made[best].fit(self._training(made[best], segments))
         log.info("nested selection of %s: %s, %d of %d held-out flights right (of %d "
@@ -280,7 +287,8 @@ class NestedSelection(Detector):
 
     def fitted(self) -> dict:
         self._check_fitted("base_")
-        return {"chosen": self.chosen_, "candidates": len(self.inner_), "inner": self.inner_,
+        return {"chosen": self.chosen_, "chosen_by": self.chosen_by_,
+                "candidates": len(self.inner_), "inner": self.inner_,
                 "base": self.base_.fitted()}
 
     # -- running: the fitted base --------------------------------------------------------

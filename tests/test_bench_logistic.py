@@ -81,3 +81,22 @@ def test_a_nan_row_does_not_spoil_the_attitude_gains_after_it():
     feats = physics.features_of(s)
     for name in ("roll_rate_gain_drop", "pitch_rate_gain_drop", "roll_asymmetry"):
         assert np.isfinite(feats[name][-50:]).all(), name
+
+
+def test_a_selection_no_candidate_can_be_scored_in_takes_the_first_and_says_so(
+        corpus_flights, caplog):
+    """On three dates a classifier without the emergency-trajectory positives cannot be
+    fitted without one of them: the first candidate of the grid is taken, the record
+    and the log say why, and the run still scores."""
+    spec = CONFIG["methods"]["bench_logistic_no_emr"]
+    nested = make_detector(spec["detector"], spec["params"])
+    scored = "2018-07-18"
+    training = [f for n, f in corpus_flights.items() if _date(n) != scored]
+    INNER_FITS.clear()
+    with caplog.at_level("WARNING"):
+        fitted = nested.fit(labelled_segments(nested, training)).fitted()
+    assert not any(c["scored"] for c in fitted["inner"])
+    assert fitted["chosen"] == nested.candidates()[0]
+    assert fitted["chosen_by"].startswith("grid order")
+    assert "the first of the grid is taken" in caplog.text
+    assert np.isfinite(nested.thresholds()).all()

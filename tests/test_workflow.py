@@ -278,7 +278,8 @@ def test_every_result_file_records_its_provenance(runs, corpus):
 def test_a_changed_method_module_reruns_exactly_its_jobs(runs, overlay):
     """A changed detector module makes a dry run schedule the detect jobs (real flights
     and injected grid) of the runs whose detectors use it (here residual_bank, its
-    energy variant, its nested selection, and learned_fusion on top of it), and no other
+    energy variant, its nested selection, learned_fusion and the project's classifier
+    on top of it), and no other
     method's: not the coincidence runs, which share its windows and thresholds
     (methods/windows.py, methods/extremes.py) but not its module. (Snakemake compares small
     inputs by content, so the module's text changes, by one comment line, and is
@@ -296,7 +297,8 @@ def test_a_changed_method_module_reruns_exactly_its_jobs(runs, overlay):
         module.write_bytes(text)
         os.utime(module, ns=(stat.st_atime_ns, stat.st_mtime_ns))
     jobs = re.findall(r"rule (\w+):\n(?:    .*\n)*?    wildcards: method=(\w+)", done.stdout)
-    assert sorted(jobs) == [("detect", m) for m in ("learned_fusion", "residual_bank",
+    assert sorted(jobs) == [("detect", m) for m in ("bench_logistic", "bench_logistic_no_emr",
+                                                    "learned_fusion", "residual_bank",
                                                     "residual_bank_energy",
                                                     "residual_bank_nested")], (
         done.stdout + done.stderr)
