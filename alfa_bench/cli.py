@@ -4,6 +4,15 @@
 truth (or ``--flights``) of the ALFA copy the workflow finds (``ALFA_DIR``, the config's
 ``alfa_dir``, or the download; ``--alfa-dir`` overrides) and writes its model file
 (:func:`alfa_bench.models.save_run`).
+
+``alfa-bench monitor FILE SOURCE`` runs the model file's detector on ``SOURCE``, in
+pymavlink's connection syntax (a ``.tlog``, ``udpin:0.0.0.0:14550``, ``tcp:host:port``,
+a serial device): an alarm is a log line (time, channel, score, threshold), progress a
+line every ``--every`` seconds (:mod:`alfa_bench.live.monitor`).
+
+``alfa-bench replay FLIGHT -o OUT`` writes a flight of the corpus as MAVLink, to a
+``.tlog`` or to a link (``udpout:127.0.0.1:14550``) at ``--speed`` times its pace
+(:mod:`alfa_bench.live.replay`).
 """
 
 from __future__ import annotations
@@ -24,6 +33,54 @@ def _fit(args: argparse.Namespace) -> int:
     return 0
 
 
+def _monitor(args: argparse.Namespace) -> int:
+    import time
+
+    from alfa_bench.live.monitor import Monitor, watch
+    from alfa_bench.methods.model_files import load_model
+
+    detector, about = load_model(args.model)
+    monitor = Monitor(detector, allow_actuators=args.allow_actuators)
+    last = [time.monotonic(), 0]
+
+    def progress() -> bool:
+        now = time.monotonic()
+        if now - last[0] >= args.every:
+            rate = (monitor.messages - last[1]) / (now - last[0])
+            print(f"{about['run']}: {rate:.0f} messages/s, {monitor.steps} grid steps, "
+                  f"{'armed' if monitor.armed else 'waiting for every signal'}", flush=True)
+            last[:] = [now, monitor.messages]
+        return False
+
+    try:
+        watch(args.source, monitor, clock=args.clock, stop=progress)
+    except KeyboardInterrupt:
+        pass
+    first = monitor.first_alarm
+    print(f"{about['run']}: {monitor.messages} messages, {monitor.steps} grid steps, "
+          + ("no alarm" if first is None else
+             f"first alarm at {first.t:.2f} s "
+             f"({', '.join(first.alarms)})"))
+    return 0
+
+
+def _replay(args: argparse.Namespace) -> int:
+    from alfa_bench.evaluation import load_corpus
+    from alfa_bench.live import replay
+
+    flight = load_corpus(args.alfa_dir).flight(args.flight)
+    if args.output.endswith(".tlog"):
+        replay.write_tlog(flight, args.output)
+        print(f"{args.flight}: written to {args.output}")
+        return 0
+    from pymavlink import mavutil
+
+    link = mavutil.mavlink_connection(args.output, input=False)
+    sent = replay.send(flight, link, speed=args.speed)
+    print(f"{args.flight}: {sent} packets sent to {args.output}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="alfa-bench", description=__doc__.splitlines()[0])
     commands = parser.add_subparsers(dest="command", required=True)
@@ -34,6 +91,24 @@ def main(argv: list[str] | None = None) -> int:
     fit.add_argument("--alfa-dir", help="the folder holding processed/ (default: ALFA_DIR, "
                                         "the config's alfa_dir, or the download)")
     fit.set_defaults(handler=_fit)
+    mon = commands.add_parser("monitor", help="run a model file on a MAVLink link or log")
+    mon.add_argument("model", help="a model file (alfa-bench fit)")
+    mon.add_argument("source", help="a .tlog, udpin:0.0.0.0:14550, tcp:host:port, a serial "
+                                    "device")
+    mon.add_argument("--clock", choices=["log", "link"],
+                     help="a log's timestamps, or the messages' own times (default: log "
+                          "for a file, link otherwise)")
+    mon.add_argument("--every", type=float, default=5.0, help="progress every so many s")
+    mon.add_argument("--allow-actuators", action="store_true",
+                     help="run a model that reads signals ALFA's fault emulation writes")
+    mon.set_defaults(handler=_monitor)
+    rep = commands.add_parser("replay", help="write a flight as MAVLink to a .tlog or link")
+    rep.add_argument("flight", help="a flight of the corpus, by name")
+    rep.add_argument("-o", "--output", required=True,
+                     help="a .tlog to write, or a link (udpout:127.0.0.1:14550)")
+    rep.add_argument("--speed", type=float, default=1.0, help="times the logged pace")
+    rep.add_argument("--alfa-dir", help="the folder holding processed/")
+    rep.set_defaults(handler=_replay)
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     try:

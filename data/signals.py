@@ -62,7 +62,7 @@ from .errors import AlfaDataError, UnknownSignalError
 from .flight import Flight
 
 __all__ = ["COVERAGE_S", "KINDS", "MAX_HOLD_S", "SIGNALS", "Sampled", "Signal", "check_physical",
-           "check_signals", "not_measured", "reads_actuators", "sample", "series"]
+           "check_signals", "hold", "not_measured", "reads_actuators", "sample", "series"]
 
 #: The longest a row's value may be held on the sampling grid, s.
 MAX_HOLD_S = 1.0
@@ -346,11 +346,21 @@ def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float,
     x = np.empty((t.size, len(names)))
     fresh = np.empty((t.size, len(names)), dtype=bool)
     for j, (name, tp) in enumerate(zip(names, topics, strict=True)):
-        row = np.searchsorted(tp.t, t, side="right") - 1
         measured = tp.values(SIGNALS[name].column)
+        row, source = hold(tp.t, np.r_[True, measured[1:] != measured[:-1]], t)
         x[:, j] = series(flight, name)[1][row]
-        changed = np.r_[True, measured[1:] != measured[:-1]]
-        last_change = np.maximum.accumulate(np.where(changed, np.arange(measured.size), 0))
-        source = last_change[row]
         fresh[:, j] = np.r_[True, source[1:] != source[:-1]]
     return Sampled(t=t, x=x, fresh=fresh, names=names, flight=flight.id)
+
+
+def hold(t_records: np.ndarray, changed: np.ndarray,
+         t_grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The zero-order hold of one signal's records onto grid times, as :func:`sample`
+    resamples ALFA and a live monitor its link: per grid time, the index of the last
+    record at or before it (its value is held) and the index of the last record at or
+    before it whose value had ``changed`` from the record before (a grid step whose
+    source differs from the step before's holds a fresh value). The records are in
+    time order; every grid time is at or after the first."""
+    row = np.searchsorted(t_records, t_grid, side="right") - 1
+    last_change = np.maximum.accumulate(np.where(changed, np.arange(changed.size), 0))
+    return row, last_change[row]

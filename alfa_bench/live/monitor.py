@@ -1,0 +1,285 @@
+"""A fitted detector on a MAVLink link or log: messages in, decisions out.
+
+:class:`Monitor` takes messages in time order (:meth:`Monitor.feed`), maps them to the
+detector's signals (:mod:`.mavlink`) and holds each signal onto the detector's grid by
+the data layer's zero-order hold (:func:`alfa_bench.data.hold`): a grid step's value is
+the signal's last record at or before it, fresh when that record's value differs from
+the record before the previous step's. The grid is :math:`k / f` on the source's clock
+(``f`` the detector's rate) from the first step at which every signal has a record; a
+step is decided once a message later than it arrives (no record for it can come after).
+Each step feeds :meth:`~alfa_bench.methods.Detector.update`; a channel whose score
+exceeds its threshold is an alarm (:class:`Decision`).
+
+The clock (:func:`message_time`) is a log's timestamp (``clock="log"``, a ``.tlog``) or
+the messages' own time fields (``clock="link"``): ``time_usec``, ``time_boot_ms``, a
+message without one dated by the last ``SYSTEM_TIME`` or timed message before it. Times
+are reported from :attr:`Monitor.origin_s`: on a log, the whole second before its first
+message (a replayed ALFA flight's own clock, to the second); on a link, the autopilot's
+boot.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import socket
+from collections import Counter
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from alfa_bench.data import MAX_HOLD_S, SIGNALS, hold
+from alfa_bench.methods import Detector
+
+from . import mavlink
+
+__all__ = ["Decision", "Monitor", "message_time", "watch"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class Decision:
+    """One grid step decided: its time (the source's clock), the scores and thresholds
+    per channel, and the channels that alarm."""
+
+    t: float
+    scores: dict[str, float]
+    thresholds: dict[str, float]
+    alarms: tuple[str, ...]
+
+
+@dataclass
+class _Records:
+    """One measured signal's records not yet behind the last grid step decided."""
+
+    t: list[float] = field(default_factory=list)
+    value: list[float] = field(default_factory=list)
+    changed: list[bool] = field(default_factory=list)
+    first: int = 0             # global index of t[0]
+    source_of_first: int = 0   # global index of the change t[0]'s value came from
+    last_value: float = math.nan
+    count: int = 0
+
+    def add(self, t: float, v: float) -> None:
+        self.t.append(t)
+        self.value.append(v)
+        # a NaN is a change every time, as the data layer's `!=` counts it
+        self.changed.append(self.count == 0 or not v == self.last_value)
+        self.last_value = v
+        self.count += 1
+
+    def at(self, t_step: float) -> tuple[float, int, float]:
+        """The value held at ``t_step``, the global index of its source and the time of
+        the record held; then the records before it are dropped."""
+        changed = np.array(self.changed)
+        changed[0] = True       # its source is kept in source_of_first
+        row, source = hold(np.array(self.t), changed, np.array([t_step]))
+        row, source = int(row[0]), int(source[0])
+        value, since = self.value[row], self.t[row]
+        source = self.source_of_first if source == 0 else self.first + source
+        if row:
+            self.source_of_first = source
+            del self.t[:row], self.value[:row], self.changed[:row]
+            self.first += row
+        return value, source, since
+
+
+def message_time(msg, clock: str, state: dict) -> float:
+    """The time of the pymavlink message ``msg``, s: its log timestamp
+    (``clock="log"``), or its own time field (``"link"``; a message without one takes
+    the last time seen, kept in ``state``)."""
+    if clock == "log":
+        return float(msg._timestamp)
+    name = mavlink.TIMED.get(msg.get_type())
+    if name == "time_usec":
+        state["t"] = msg.time_usec * 1e-6
+    elif name == "time_boot_ms":
+        state["t"] = msg.time_boot_ms * 1e-3
+    return state.get("t", math.nan)
+
+
+class Monitor:
+    """A fitted ``detector`` on a stream of MAVLink messages (module docstring).
+
+    Parameters
+    ----------
+    detector : Detector
+        Fitted (from a model file: :func:`alfa_bench.load_model`).
+    allow_actuators : bool
+        Run a detector that reads a signal ALFA's fault emulation writes (servo outputs,
+        throttle); refused by default.
+    on_decision : callable, optional
+        Called with every :class:`Decision`.
+    stale_s : float
+        The longest a signal's value is held (the data layer's
+        :data:`~alfa_bench.data.MAX_HOLD_S`, beyond which it refuses a flight): past it,
+        the monitor re-arms.
+
+    The input's state is named in the log when it changes (:attr:`state`): waiting for
+    every signal, armed, a value out of the signal's physical bounds (dropped, the last
+    plausible one held), a signal stale (re-arming). A message older than one taken
+    (a clock jump back, a reordered packet) is dropped; :attr:`dropped` counts each
+    kind. A lost or duplicated message changes nothing but the freshness it carried.
+    """
+
+    def __init__(self, detector: Detector, allow_actuators: bool = False,
+                 on_decision=None, stale_s: float = MAX_HOLD_S):
+        names = detector.signals()
+        actuators = [n for n in names if SIGNALS[n].kind == "actuator"]
+        if actuators and not allow_actuators:
+            raise ValueError(f"the model reads {actuators}, written by ALFA's fault "
+                             "emulation, not measured: refused for a live link unless "
+                             "allowed explicitly")
+        self.detector = detector.reset()
+        self.names = tuple(names)
+        self.measured = mavlink.fields_for(names)
+        self.records = {n: _Records() for n in self.measured}
+        self.rate_hz = float(detector.rate_hz)
+        self.channels = detector.channels()
+        self.thresholds = dict(zip(self.channels, map(float, detector.thresholds()),
+                                   strict=True))
+        self.on_decision = on_decision
+        self.stale_s = stale_s
+        self.next_step: int | None = None
+        self.last_t = -math.inf
+        self.state = "waiting for every signal"
+        self.dropped: Counter = Counter()
+        self.prev_source = {n: -1 for n in self.measured}
+        self.steps = 0
+        self.messages = 0
+        self.first_alarm: Decision | None = None
+        self.alarming: set[str] = set()
+        self.origin_s: float | None = None
+
+    @property
+    def armed(self) -> bool:
+        """Whether every signal has a record: the grid has started."""
+        return self.next_step is not None
+
+    def feed(self, t: float, message: str, values: dict[str, float]) -> list[Decision]:
+        """Take a message of type ``message`` at time ``t`` whose signals are ``values``
+        (:func:`.mavlink.decode`): decide every grid step before ``t``, then keep its
+        records. Returns the steps decided."""
+        self.messages += 1
+        if not t >= self.last_t:         # earlier than a message taken, or no time
+            kind = "out of order" if math.isfinite(t) else "no time"
+            self.dropped[kind] += 1
+            self._set_state(f"{kind}: messages earlier than one taken are dropped",
+                            self.last_t)
+            return []
+        decided = self._advance(t) if self.armed else []
+        self.last_t = t
+        plausible = True
+        for name, v in values.items():
+            if name not in self.records:
+                continue
+            lo, hi = SIGNALS[name].bounds or (-math.inf, math.inf)
+            if not lo <= v <= hi:        # NaN too
+                self.dropped[f"implausible {name}"] += 1
+                self._set_state(f"implausible {name}: {v:.6g} {SIGNALS[name].unit}, "
+                                "the last plausible value held", t)
+                plausible = False
+                continue
+            self.records[name].add(t, v)
+        if not self.armed and all(r.count for r in self.records.values()):
+            start = max(r.t[0] for r in self.records.values())
+            self.next_step = math.ceil(start * self.rate_hz)
+        if self.armed and plausible:
+            self._set_state("armed", t)
+        return decided
+
+    def _set_state(self, state: str, t: float) -> None:
+        if state != self.state:
+            log.warning("%s at t=%.2f s", state, t)
+            self.state = state
+
+    def _advance(self, t: float) -> list[Decision]:
+        out = []
+        while self.armed and self.next_step / self.rate_hz < t:
+            decision = self._step(self.next_step / self.rate_hz)
+            if decision is not None:
+                out.append(decision)
+                self.next_step += 1
+        return out
+
+    def _rearm(self, stale: list[str], t_step: float) -> None:
+        """A signal held longer than ``stale_s``: the detector starts again from its
+        reset (its warm-up too) once every signal has a record after the gap."""
+        self._set_state(f"stale: {', '.join(stale)} held over {self.stale_s:g} s; "
+                        "re-arming", t_step)
+        self.detector.reset()
+        self.records = {n: _Records() for n in self.measured}
+        self.prev_source = {n: -1 for n in self.measured}
+        self.next_step = None
+
+    def _step(self, t_step: float) -> Decision | None:
+        held, fresh, stale = {}, {}, []
+        for name, r in self.records.items():
+            held[name], source, since = r.at(t_step)
+            if t_step - since > self.stale_s:
+                stale.append(name)
+            fresh[name] = source != self.prev_source[name]
+            self.prev_source[name] = source
+        if stale:
+            self._rearm(stale, t_step)
+            return None
+        x = np.array([held[mavlink.DIFFERENCES[n][0]] - held[mavlink.DIFFERENCES[n][1]]
+                      if n in mavlink.DIFFERENCES else held[n] for n in self.names])
+        f = np.array([fresh[mavlink.DIFFERENCES[n][0]] if n in mavlink.DIFFERENCES
+                      else fresh[n] for n in self.names])
+        score = np.asarray(self.detector.update(x, f), dtype=float)
+        alarm = self.detector.alarms(score[None, :])[0]
+        decision = Decision(t_step, dict(zip(self.channels, map(float, score), strict=True)),
+                            self.thresholds,
+                            tuple(c for c, a in zip(self.channels, alarm, strict=True) if a))
+        self.steps += 1
+        if decision.alarms and self.first_alarm is None:
+            self.first_alarm = decision
+        for c in set(decision.alarms) - self.alarming:
+            log.warning("alarm t=%.2f s channel=%s score=%.4g threshold=%.4g", t_step, c,
+                        decision.scores[c], decision.thresholds[c])
+        self.alarming = set(decision.alarms)
+        if self.on_decision is not None:
+            self.on_decision(decision)
+        return decision
+
+
+def watch(source: str, monitor: Monitor, clock: str | None = None,
+          stop=lambda: False) -> Monitor:
+    """Feed ``monitor`` from ``source`` in pymavlink's connection syntax (a ``.tlog``
+    file, ``udpin:0.0.0.0:14550``, ``tcp:host:port``, a serial device) until a file
+    ends or ``stop()`` is true. ``clock`` defaults to ``"log"`` for a file, else
+    ``"link"``; a log's times are counted from the whole second before its first
+    message (``monitor.origin_s``), so that its grid is the flight's."""
+    from pymavlink import mavutil
+
+    is_file = Path(source).is_file()
+    clock = clock or ("log" if is_file else "link")
+    conn = mavutil.mavlink_connection(source, robust_parsing=True, dialect="ardupilotmega")
+    sock = getattr(conn, "port", None)
+    if isinstance(sock, socket.socket) and sock.type == socket.SOCK_DGRAM:
+        # a burst outruns a slow step: the kernel holds it rather than drop it
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 8 << 20)
+    wanted = [*mavlink.MESSAGES, "SYSTEM_TIME"]
+    state: dict = {}
+    monitor.origin_s = None
+    try:
+        while not stop():
+            msg = conn.recv_match(type=wanted, blocking=not is_file, timeout=0.2)
+            if msg is None:
+                if is_file:
+                    break
+                continue
+            t = message_time(msg, clock, state)
+            if not math.isfinite(t):
+                continue
+            if monitor.origin_s is None:
+                monitor.origin_s = float(math.floor(t)) if clock == "log" else 0.0
+            kind = msg.get_type()
+            monitor.feed(t - monitor.origin_s, kind,
+                         mavlink.decode(kind, lambda name, m=msg: getattr(m, name)))
+    finally:
+        conn.close()
+    return monitor

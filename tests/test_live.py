@@ -1,0 +1,252 @@
+"""A fitted detector on MAVLink (alfa_bench/live): a flight replayed as a .tlog, or over
+UDP on localhost, gives the monitor the workflow's first alarm within one grid step; a
+model reading the fault emulation's signals is refused for a link unless allowed."""
+
+import os
+import socket
+import threading
+
+import numpy as np
+import pytest
+
+import alfa_bench as ab
+from alfa_bench.data import hold, parse_flight_name, sample
+from alfa_bench.live import mavlink, replay
+from alfa_bench.live.monitor import Monitor, watch
+from alfa_bench.methods import make_detector
+
+RUNS = ["residual_logistic_published_date", "coincidence", "residual_bank"]
+
+pytest.importorskip("pymavlink")
+
+
+def _date(name: str) -> str:
+    return str(parse_flight_name(name)["date"])
+
+
+@pytest.fixture(scope="module")
+def local(corpus, tmp_path_factory):
+    return ab.load_corpus(corpus.parent, cache=tmp_path_factory.mktemp("cache"))
+
+
+def _batch_first_alarm(detector, flight) -> float | None:
+    s = sample(flight, detector.signals(), detector.rate_hz)
+    alarm = detector.alarms(detector.run(s)[0]).any(axis=1)
+    return float(s.t[np.argmax(alarm)]) if alarm.any() else None
+
+
+def _same(live: float | None, batch: float | None, rate_hz: float) -> bool:
+    if live is None or batch is None:
+        return live is batch
+    return abs(live - batch) <= 1.0 / rate_hz + 1e-9
+
+
+def _tlog_first_alarm(detector, flight, path) -> float | None:
+    replay.write_tlog(flight, path, detector.signals())
+    monitor = watch(str(path), Monitor(detector))
+    if monitor.first_alarm is None:
+        return None
+    return monitor.first_alarm.t + monitor.origin_s - replay.flight_epoch_s(flight)
+
+
+def _check_flights(corpus, names, tmp_path) -> list[str]:
+    """Per run and flight, the monitor's first alarm on the replayed .tlog against the
+    batch run's, the run fitted without the flight's date; the differences, named."""
+    wrong = []
+    for run in RUNS:
+        fits = {}
+        for name in names:
+            d = _date(name)
+            if d not in fits:
+                fits[d] = ab.fit_run(run, corpus, [n for n in corpus.flights if _date(n) != d])
+            det, flight = fits[d], corpus.flight(name)
+            batch = _batch_first_alarm(det, flight)
+            live = _tlog_first_alarm(det, flight, tmp_path / f"{run}.tlog")
+            if not _same(live, batch, det.rate_hz):
+                wrong.append(f"{run} on {name}: monitor {live}, workflow {batch}")
+    return wrong
+
+
+def test_a_replayed_log_gives_the_workflows_first_alarm(local, tmp_path):
+    """Every flight of a date, and one of another, each alarming in the batch run or not."""
+    names = [n for n in local.flights if _date(n) in ("2018-07-18", "2018-10-05")]
+    wrong = _check_flights(local, names, tmp_path)
+    assert not wrong, wrong
+
+
+def test_the_workflows_record_is_the_batch_run_the_monitor_matches(local):
+    """The batch first alarm the monitor is held to is the record's: the same fold fit."""
+    run = "coincidence"
+    result = ab.evaluate(run, local, subsets=["all"])
+    for record in result.records:
+        d = _date(record["flight"])
+        det = ab.fit_run(run, local, [n for n in local.flights if _date(n) != d])
+        assert _batch_first_alarm(det, local.flight(record["flight"])) == record[
+            "first_alarm_s"]
+
+
+def test_the_hold_is_the_data_layers(local):
+    """The monitor's grid values and freshness are sample()'s, to float32 rounding, on a
+    flight replayed through the map."""
+    det = ab.fit_run("residual_bank", local)
+    flight = local.flight(next(iter(local.flights)))
+    s = sample(flight, det.signals(), det.rate_hz)
+    fed = []
+    monitor = Monitor(det)
+    update = monitor.detector.update
+    monitor.detector.update = lambda x, f: fed.append((x.copy(), f.copy())) or update(x, f)
+    for t, message, values in replay.messages(flight, det.signals()):
+        fields = mavlink.encode(message, values)
+        back = mavlink.decode(message, lambda n, fs=fields: float(np.float32(fs.get(n, 0))))
+        monitor.feed(t, message, back)
+    x = np.array([a for a, _ in fed])[:s.t.size]
+    fresh = np.array([b for _, b in fed])[:s.t.size]
+    assert x.shape == s.x.shape
+    np.testing.assert_allclose(x, s.x, rtol=1e-6, atol=1e-5)
+    np.testing.assert_array_equal(fresh, s.fresh)
+
+
+def test_hold_counts_a_repeated_value_as_held_and_a_new_one_as_fresh():
+    t = np.array([0.0, 0.1, 0.2, 0.3])
+    changed = np.array([True, False, True, False])
+    row, source = hold(t, changed, np.array([0.05, 0.15, 0.25, 0.3]))
+    assert row.tolist() == [0, 1, 2, 3] and source.tolist() == [0, 0, 2, 2]
+
+
+def _free_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_over_udp_on_localhost_the_first_alarm_is_the_workflows(local):
+    from pymavlink import mavutil
+
+    run = "coincidence"
+    name = next(n for n in local.flights if "engine" in n)
+    d = _date(name)
+    det = ab.fit_run(run, local, [n for n in local.flights if _date(n) != d])
+    flight = local.flight(name)
+    port, done = _free_port(), threading.Event()
+    monitor = Monitor(det)
+    listener = threading.Thread(target=watch, args=(f"udpin:127.0.0.1:{port}", monitor),
+                                kwargs={"stop": done.is_set})
+    listener.start()
+    try:
+        link = mavutil.mavlink_connection(f"udpout:127.0.0.1:{port}", input=False)
+        replay.send(flight, link, det.signals(), speed=20.0)
+    finally:
+        threading.Timer(1.0, done.set).start()
+        listener.join(10)
+    batch = _batch_first_alarm(det, flight)
+    live = None if monitor.first_alarm is None else monitor.first_alarm.t
+    assert monitor.steps > 0
+    assert _same(live, batch, det.rate_hz), (live, batch)
+
+
+def test_a_model_reading_the_emulation_is_refused_for_a_link_unless_allowed():
+    det = make_detector("emulation_oracle")
+    with pytest.raises(ValueError, match="written by ALFA's fault emulation"):
+        Monitor(det.fit([]))
+    assert Monitor(det.fit([]), allow_actuators=True).names == tuple(det.signals())
+
+
+@pytest.mark.skipif(not os.environ.get("ALFA_DIR"), reason="real ALFA flights: set ALFA_DIR")
+def test_on_real_flights_a_replayed_log_gives_the_workflows_first_alarm(tmp_path):
+    """The first flight of each date (every local flight with ALFA_LIVE_ALL=1: about 6
+    minutes, run at each stop); each run fitted without the flight's date."""
+    corpus = ab.load_corpus()
+    names = list(corpus.flights)
+    if not os.environ.get("ALFA_LIVE_ALL"):
+        names = list({_date(n): n for n in reversed(names)}.values())
+    wrong = _check_flights(corpus, names, tmp_path)
+    assert not wrong, wrong
+
+
+def _faulty_tlog(flight, signals, path, fault: str, seed: int = 0):
+    """The flight's replay as a .tlog with one fault of the link applied."""
+    import struct
+
+    rng = np.random.default_rng(seed)
+    epoch = replay.flight_epoch_s(flight)
+    packets = list(replay.packets(flight, signals))
+    times = np.array([t for t, _ in packets])
+    mid = float(times[len(times) // 2])
+    out, out_of_range = [], False
+    for i, (t, p) in enumerate(packets):
+        if fault == "loss" and rng.random() < 0.1:
+            continue
+        if fault == "corrupt" and rng.random() < 0.05:
+            b = bytearray(p)
+            b[len(b) // 2] ^= 0xFF
+            p = bytes(b)
+        if fault == "silence" and mid <= t < mid + 3.0:
+            continue
+        if fault == "jump_back" and t >= mid:
+            t -= 10.0
+        if fault == "range" and t >= mid and not out_of_range:
+            p = _with_roll(p, 100.0)
+            out_of_range = p != packets[i][1]
+        out.append((t, p))
+        if fault == "duplicate" and rng.random() < 0.05:
+            out.append((t, p))
+        if fault == "flood" and mid <= t < mid + 0.001:
+            out += [(t + k / 2000.0, p) for k in range(4000)]
+    if fault == "reorder":
+        for i in range(0, len(out) - 1, 20):
+            out[i], out[i + 1] = (out[i][0], out[i + 1][1]), (out[i + 1][0], out[i][1])
+    with open(path, "wb") as f:
+        for t, p in out:
+            f.write(struct.pack(">Q", round((epoch + t) * 1e6)) + p)
+    return path
+
+
+def _with_roll(packet: bytes, roll_rad: float) -> bytes:
+    """An ATTITUDE packet (any other is returned as it is) with its roll set."""
+    from pymavlink.dialects.v20 import ardupilotmega as mav
+
+    m = mav.MAVLink(None, srcSystem=1, srcComponent=1)
+    msg = m.parse_char(packet)
+    if msg is None or msg.get_type() != "ATTITUDE":
+        return packet
+    msg.roll = roll_rad
+    return mav.MAVLink_attitude_message(
+        msg.time_boot_ms, msg.roll, msg.pitch, msg.yaw, msg.rollspeed, msg.pitchspeed,
+        msg.yawspeed).pack(m)
+
+
+FAULTS = {"loss": None, "reorder": None, "duplicate": None, "corrupt": None,
+          "silence": "stale", "jump_back": "out of order", "flood": None,
+          "range": "implausible roll"}
+
+
+@pytest.fixture(scope="module")
+def quiet_flight(local, tmp_path_factory):
+    """A fault-free flight, and a detector fitted without its date that does not alarm
+    on its clean replay."""
+    name = next(n for n in local.flights if "no_failure" in n and "2018-10-05" in n)
+    d = _date(name)
+    det = ab.fit_run("residual_logistic_published_date", local,
+                     [n for n in local.flights if _date(n) != d])
+    flight = local.flight(name)
+    assert _tlog_first_alarm(det, flight, tmp_path_factory.mktemp("clean") / "c.tlog") is None
+    return det, flight
+
+
+@pytest.mark.parametrize("fault", list(FAULTS))
+def test_a_fault_of_the_link_alone_raises_no_fault_alarm(fault, quiet_flight, tmp_path,
+                                                         caplog):
+    """With each fault of the link the monitor neither crashes nor alarms on a flight
+    whose clean replay is quiet; a silence (stale: the monitor re-arms), a clock jump
+    back (out of order: dropped) and a value out of range (implausible: dropped) are
+    named in the log."""
+    det, flight = quiet_flight
+    path = _faulty_tlog(flight, det.signals(), tmp_path / f"{fault}.tlog", fault)
+    with caplog.at_level("WARNING"):
+        monitor = watch(str(path), Monitor(det))
+    assert monitor.first_alarm is None
+    assert monitor.steps > 0
+    if FAULTS[fault]:
+        assert FAULTS[fault] in caplog.text
+    if fault == "jump_back":
+        assert monitor.dropped["out of order"] > 0
