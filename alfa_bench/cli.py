@@ -81,6 +81,13 @@ def _replay(args: argparse.Namespace) -> int:
     return 0
 
 
+def _positive(text: str) -> float:
+    value = float(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be above 0, got {text}")
+    return value
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="alfa-bench", description=__doc__.splitlines()[0])
     commands = parser.add_subparsers(dest="command", required=True)
@@ -98,7 +105,8 @@ def main(argv: list[str] | None = None) -> int:
     mon.add_argument("--clock", choices=["log", "link"],
                      help="a log's timestamps, or the messages' own times (default: log "
                           "for a file, link otherwise)")
-    mon.add_argument("--every", type=float, default=5.0, help="progress every so many s")
+    mon.add_argument("--every", type=_positive, default=5.0,
+                     help="progress every so many s")
     mon.add_argument("--allow-actuators", action="store_true",
                      help="run a model that reads signals ALFA's fault emulation writes")
     mon.set_defaults(handler=_monitor)
@@ -106,7 +114,8 @@ def main(argv: list[str] | None = None) -> int:
     rep.add_argument("flight", help="a flight of the corpus, by name")
     rep.add_argument("-o", "--output", required=True,
                      help="a .tlog to write, or a link (udpout:127.0.0.1:14550)")
-    rep.add_argument("--speed", type=float, default=1.0, help="times the logged pace")
+    rep.add_argument("--speed", type=_positive, default=1.0,
+                     help="times the logged pace (inf: as fast as it goes)")
     rep.add_argument("--alfa-dir", help="the folder holding processed/")
     rep.set_defaults(handler=_replay)
     args = parser.parse_args(argv)

@@ -66,9 +66,11 @@ def chosen_configurations(records: list[dict]) -> str:
     by_fold = {}
     for r in records:
         cal = r.get("calibration") or {}
-        chosen = (cal.get("fitted") or {}).get("chosen")
-        if chosen is not None:
-            by_fold[cal.get("fold")] = _setting(chosen)
+        fitted = cal.get("fitted") or {}
+        if fitted.get("chosen") is not None:
+            blind = str(fitted.get("chosen_by", "")).startswith("grid order")
+            by_fold[cal.get("fold")] = _setting(fitted["chosen"]) + (
+                " (grid order: none could be scored)" if blind else "")
     counts = Counter(by_fold.values()).most_common()
     return "; ".join(f"{c} ({n} date{'s' if n > 1 else ''})" if i == 0 else f"{c} ({n})"
                      for i, (c, n) in enumerate(counts))

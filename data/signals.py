@@ -54,6 +54,7 @@ ALFA flight passes.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -62,7 +63,8 @@ from .errors import AlfaDataError, UnknownSignalError
 from .flight import Flight
 
 __all__ = ["COVERAGE_S", "KINDS", "MAX_HOLD_S", "SIGNALS", "Sampled", "Signal", "check_physical",
-           "check_signals", "hold", "not_measured", "reads_actuators", "sample", "series"]
+           "check_signals", "first_grid_step", "hold", "not_measured", "reads_actuators", "sample",
+           "series"]
 
 #: The longest a row's value may be held on the sampling grid, s.
 MAX_HOLD_S = 1.0
@@ -336,7 +338,7 @@ def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float,
         _check_coverage(flight, tp)
     start = max(float(tp.t[0]) for tp in topics)
     stop = min(float(tp.t[-1]) for tp in topics)
-    k = np.arange(np.ceil(start * rate_hz), np.floor(stop * rate_hz) + 1)
+    k = np.arange(first_grid_step(start, rate_hz), np.floor(stop * rate_hz) + 1)
     t = k / rate_hz
     if t.size == 0:
         raise AlfaDataError(f"signals {list(names)} never overlap in time", flight=flight.id)
@@ -351,6 +353,14 @@ def sample(flight: Flight, names: tuple[str, ...] | list[str], rate_hz: float,
         x[:, j] = series(flight, name)[1][row]
         fresh[:, j] = np.r_[True, source[1:] != source[:-1]]
     return Sampled(t=t, x=x, fresh=fresh, names=names, flight=flight.id)
+
+
+def first_grid_step(start_s: float, rate_hz: float) -> int:
+    r"""The first grid step :math:`k` with :math:`k / f \ge` ``start_s``: ``ceil`` of the
+    product alone can fall one step short in floating point (1.7000000000000002 s at
+    10 Hz gives 17, and 1.7 s holds no record yet)."""
+    k = math.ceil(start_s * rate_hz)
+    return k + 1 if k / rate_hz < start_s else k
 
 
 def hold(t_records: np.ndarray, changed: np.ndarray,

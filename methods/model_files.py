@@ -20,8 +20,11 @@ attribute ending in ``_``, :func:`~.base.learned_state`) encoded as
 Anything else (a library's estimator object, an object array) is refused when saving,
 naming the attribute. Loading reads the archive with ``allow_pickle=False``, checks a
 SHA-256 over the document and every array, the format and the package version, builds
-the detector from the registry by name, sets its state and checks that its fit token
-is the one saved: the detector is the fitted one, by value, or the load fails.
+the detector from the registry by name, sets its learned state (names ending in ``_``
+only) and checks that its fit token is the one saved: the detector is the fitted one,
+by value, or the load fails. The digests are in the file: they catch a damaged file or
+an edit that did not recompute them, not a forger; what holds against any file is
+that loading runs none of its code.
 """
 
 from __future__ import annotations
@@ -121,6 +124,8 @@ def _build(spec: dict, arrays: dict[str, np.ndarray]) -> Detector:
 
     detector = make_detector(spec["detector"], _decode(spec["params"], arrays))
     for name, v in _decode(spec["state"], arrays).items():
+        if not name.endswith("_") or name.startswith("_"):
+            raise ValueError(f"{name!r} is not a learned attribute")
         setattr(detector, name, v)
     return detector
 
@@ -186,7 +191,7 @@ def load_model(path: str | os.PathLike) -> tuple[Detector, dict]:
         raise ModelFileError(f"{path}: not an alfa-bench model file") from None
     if _digest(document, arrays) != saved:
         raise ModelFileError(f"{path}: its content does not match its SHA-256: the file is "
-                             "damaged or was altered")
+                             "damaged or was edited")
     body = json.loads(document)
     if body.get("format") != FORMAT or body.get("format_version") != FORMAT_VERSION:
         raise ModelFileError(f"{path}: format {body.get('format')!r} version "

@@ -215,7 +215,7 @@ class NestedSelection(Detector):
         if len(folds) < 2:
             raise CalibrationError(f"nested selection needs training flights of two dates or "
                                    f"more; found {len(folds)}")
-        digest = {id(f): segment_digest(f.sampled) for f in segments}
+        digest = {id(f): segment_digest(f) for f in segments}
         candidates, groups = self.candidates(), _sharing(made)
         tally = [{"scored": 0, "right": 0, "unfit": []} for _ in made]
         for d, training, held in folds:

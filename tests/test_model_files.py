@@ -101,6 +101,17 @@ def test_a_state_altered_and_signed_again_is_not_the_fit_saved(saved, tmp_path):
         load_model(tmp_path / "state.abm")
 
 
+def test_a_state_that_is_not_learned_is_refused(saved, tmp_path):
+    """Only learned attributes (ending in ``_``) are set from a file: not a class
+    attribute such as the grid rate, which no digest covers."""
+    members = _members(saved["coincidence"])
+    body = _document(members)
+    body["model"]["state"]["dict"]["rate_hz"] = 1000.0
+    _write(tmp_path / "rate.abm", _with_document(members, body, resign=True))
+    with pytest.raises(ModelFileError, match="'rate_hz' is not a learned attribute"):
+        load_model(tmp_path / "rate.abm")
+
+
 def test_another_version_or_an_unknown_detector_is_refused(saved, tmp_path, monkeypatch):
     members = _members(saved["coincidence"])
     body = _document(members)

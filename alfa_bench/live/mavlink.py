@@ -21,7 +21,7 @@ import math
 from dataclasses import dataclass
 
 __all__ = ["DIFFERENCES", "FIELDS", "MESSAGES", "TIMED", "WIND", "Field", "decode", "encode",
-           "fields_for"]
+           "fields_for", "messages_for"]
 
 
 @dataclass(frozen=True)
@@ -51,8 +51,9 @@ FIELDS = {f.signal: f for f in [
     Field("pitch_cmd", "NAV_CONTROLLER_OUTPUT", "nav_pitch", "deg"),
     Field("yaw_cmd", "NAV_CONTROLLER_OUTPUT", "nav_bearing", "deg"),
     Field("altitude_error", "NAV_CONTROLLER_OUTPUT", "alt_error", "m"),
-    # ALFA logs ArduPlane's airspeed error in cm/s; MAVLink carries it in m/s
-    Field("airspeed_error", "NAV_CONTROLLER_OUTPUT", "aspd_error", "m/s", 100.0),
+    # MAVLink says m/s, but ArduPlane sends cm/s (airspeed_error * 100, its PR 7933),
+    # which ALFA logs
+    Field("airspeed_error", "NAV_CONTROLLER_OUTPUT", "aspd_error", "cm/s"),
     Field("airspeed", "VFR_HUD", "airspeed", "m/s"),
     Field("rel_alt", "GLOBAL_POSITION_INT", "relative_alt", "mm", 1e-3),
     Field("nav_vel_north", "GLOBAL_POSITION_INT", "vx", "cm/s", 1e-2),
@@ -105,6 +106,12 @@ def encode(message: str, values: dict[str, float]) -> dict[str, float]:
         return {"direction": math.degrees(math.atan2(-east, -north)) % 360.0,
                 "speed": math.hypot(north, east), "speed_z": 0.0}
     return {FIELDS[s].field: v / FIELDS[s].gain for s, v in values.items()}
+
+
+def messages_for(signals) -> list[str]:
+    """The message types that give ``signals`` (:func:`fields_for` them)."""
+    measured = set(fields_for(signals))
+    return [m for m, names in MESSAGES.items() if measured.intersection(names)]
 
 
 def fields_for(signals) -> list[str]:

@@ -29,12 +29,16 @@ from pathlib import Path
 
 import numpy as np
 
-from alfa_bench.data import MAX_HOLD_S, SIGNALS, hold
+from alfa_bench.data import MAX_HOLD_S, SIGNALS, first_grid_step, hold
 from alfa_bench.methods import Detector
 
 from . import mavlink
 
-__all__ = ["Decision", "Monitor", "message_time", "watch"]
+__all__ = ["REORDER_S", "Decision", "Monitor", "message_time", "watch"]
+
+#: a message this much earlier than one taken is re-dated to it (a ``time_boot_ms``
+#: after a ``time_usec`` of the same millisecond), not dropped, s
+REORDER_S = 0.002
 
 log = logging.getLogger(__name__)
 
@@ -69,6 +73,12 @@ class _Records:
         self.changed.append(self.count == 0 or not v == self.last_value)
         self.last_value = v
         self.count += 1
+
+    def forget_before(self, t: float) -> None:
+        """Drop the records before ``t``, the last one kept (while the grid waits)."""
+        n = min(int(np.searchsorted(self.t, t)), len(self.t) - 1)
+        if n > 0:
+            self.at(self.t[n])
 
     def at(self, t_step: float) -> tuple[float, int, float]:
         """The value held at ``t_step``, the global index of its source and the time of
@@ -163,12 +173,19 @@ class Monitor:
         (:func:`.mavlink.decode`): decide every grid step before ``t``, then keep its
         records. Returns the steps decided."""
         self.messages += 1
-        if not t >= self.last_t:         # earlier than a message taken, or no time
-            kind = "out of order" if math.isfinite(t) else "no time"
-            self.dropped[kind] += 1
-            self._set_state(f"{kind}: messages earlier than one taken are dropped",
+        if not math.isfinite(t):
+            self.dropped["no time"] += 1
+            return []
+        if t < self.last_t - self.stale_s:   # the source's clock started again
+            self._rearm([], t, f"the clock went back {self.last_t - t:.1f} s")
+            self.last_t = t
+        elif t < self.last_t - REORDER_S:
+            self.dropped["out of order"] += 1
+            self._set_state("out of order: messages earlier than one taken are dropped",
                             self.last_t)
             return []
+        # a millisecond stamp after a microsecond one of the same instant
+        t = max(t, self.last_t)
         decided = self._advance(t) if self.armed else []
         self.last_t = t
         plausible = True
@@ -183,9 +200,13 @@ class Monitor:
                 plausible = False
                 continue
             self.records[name].add(t, v)
-        if not self.armed and all(r.count for r in self.records.values()):
-            start = max(r.t[0] for r in self.records.values())
-            self.next_step = math.ceil(start * self.rate_hz)
+        if not self.armed:
+            if all(r.count for r in self.records.values()):
+                start = max(r.t[0] for r in self.records.values())
+                self.next_step = first_grid_step(start, self.rate_hz)
+            else:               # waiting: what is older than a hold cannot start the grid
+                for r in self.records.values():
+                    r.forget_before(t - self.stale_s)
         if self.armed and plausible:
             self._set_state("armed", t)
         return decided
@@ -204,11 +225,12 @@ class Monitor:
                 self.next_step += 1
         return out
 
-    def _rearm(self, stale: list[str], t_step: float) -> None:
-        """A signal held longer than ``stale_s``: the detector starts again from its
-        reset (its warm-up too) once every signal has a record after the gap."""
-        self._set_state(f"stale: {', '.join(stale)} held over {self.stale_s:g} s; "
-                        "re-arming", t_step)
+    def _rearm(self, stale: list[str], t_step: float, why: str | None = None) -> None:
+        """A signal held longer than ``stale_s`` (or a clock that started again): the
+        detector starts again from its reset (its warm-up too) once every signal has a
+        record after the gap."""
+        why = why or f"stale: {', '.join(stale)} held over {self.stale_s:g} s"
+        self._set_state(f"{why}; re-arming", t_step)
         self.detector.reset()
         self.records = {n: _Records() for n in self.measured}
         self.prev_source = {n: -1 for n in self.measured}
@@ -250,7 +272,8 @@ def watch(source: str, monitor: Monitor, clock: str | None = None,
           stop=lambda: False) -> Monitor:
     """Feed ``monitor`` from ``source`` in pymavlink's connection syntax (a ``.tlog``
     file, ``udpin:0.0.0.0:14550``, ``tcp:host:port``, a serial device) until a file
-    ends or ``stop()`` is true. ``clock`` defaults to ``"log"`` for a file, else
+    ends or ``stop()`` is true: the message types its signals need, from the system that
+    sent the first of them. ``clock`` defaults to ``"log"`` for a file, else
     ``"link"``; a log's times are counted from the whole second before its first
     message (``monitor.origin_s``), so that its grid is the flight's."""
     from pymavlink import mavutil
@@ -262,15 +285,21 @@ def watch(source: str, monitor: Monitor, clock: str | None = None,
     if isinstance(sock, socket.socket) and sock.type == socket.SOCK_DGRAM:
         # a burst outruns a slow step: the kernel holds it rather than drop it
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 8 << 20)
-    wanted = [*mavlink.MESSAGES, "SYSTEM_TIME"]
+    wanted = [*mavlink.messages_for(monitor.names), "SYSTEM_TIME"]
     state: dict = {}
     monitor.origin_s = None
+    system = None
     try:
         while not stop():
             msg = conn.recv_match(type=wanted, blocking=not is_file, timeout=0.2)
             if msg is None:
                 if is_file:
                     break
+                continue
+            # the autopilot's messages only: a ground station's SYSTEM_TIME is another clock
+            system = msg.get_srcSystem() if system is None else system
+            if msg.get_srcSystem() != system:
+                monitor.dropped["another system"] += 1
                 continue
             t = message_time(msg, clock, state)
             if not math.isfinite(t):
