@@ -43,12 +43,19 @@ def _monitor(args: argparse.Namespace) -> int:
     monitor = Monitor(detector, allow_actuators=args.allow_actuators)
     last = [time.monotonic(), 0]
 
+    quiet_since = [time.monotonic(), 0]
+
     def progress() -> bool:
         now = time.monotonic()
+        if monitor.messages != quiet_since[1]:
+            quiet_since[:] = [now, monitor.messages]
         if now - last[0] >= args.every:
             rate = (monitor.messages - last[1]) / (now - last[0])
+            state = (f"silent for {now - quiet_since[0]:.0f} s" if rate == 0 else
+                     "armed" if monitor.armed else
+                     f"waiting for {', '.join(monitor.missing()) or 'a later message'}")
             print(f"{about['run']}: {rate:.0f} messages/s, {monitor.steps} grid steps, "
-                  f"{'armed' if monitor.armed else 'waiting for every signal'}", flush=True)
+                  f"{state}", flush=True)
             last[:] = [now, monitor.messages]
         return False
 
@@ -57,10 +64,13 @@ def _monitor(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         pass
     first = monitor.first_alarm
+    if not monitor.steps:
+        print(f"{about['run']}: {monitor.messages} messages, never armed: no message gave "
+              f"{', '.join(monitor.missing()) or 'a later time'}", file=sys.stderr)
+        return 1
     print(f"{about['run']}: {monitor.messages} messages, {monitor.steps} grid steps, "
           + ("no alarm" if first is None else
-             f"first alarm at {first.t:.2f} s "
-             f"({', '.join(first.alarms)})"))
+             f"first alarm at {first.t:.2f} s ({', '.join(first.alarms)})"))
     return 0
 
 
@@ -68,7 +78,10 @@ def _replay(args: argparse.Namespace) -> int:
     from alfa_bench.evaluation import load_corpus
     from alfa_bench.live import replay
 
-    flight = load_corpus(args.alfa_dir).flight(args.flight)
+    corpus = load_corpus(args.alfa_dir)
+    if args.flight not in set(corpus.manifest["flight"]):
+        raise KeyError(f"no flight {args.flight!r} in the corpus at {corpus.processed}")
+    flight = corpus.flight(args.flight)
     if args.output.endswith(".tlog"):
         replay.write_tlog(flight, args.output)
         print(f"{args.flight}: written to {args.output}")
@@ -91,14 +104,17 @@ def _positive(text: str) -> float:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="alfa-bench", description=__doc__.splitlines()[0])
     commands = parser.add_subparsers(dest="command", required=True)
-    fit = commands.add_parser("fit", help="fit a config run and write its model file")
+    shown = {"formatter_class": argparse.ArgumentDefaultsHelpFormatter}
+    fit = commands.add_parser("fit", help="fit a config run and write its model file",
+                              **shown)
     fit.add_argument("run", help="a run of the config (config/config.yaml's methods)")
     fit.add_argument("-o", "--output", required=True, help="the model file to write")
     fit.add_argument("--flights", nargs="+", help="fit on these flights only (by name)")
     fit.add_argument("--alfa-dir", help="the folder holding processed/ (default: ALFA_DIR, "
                                         "the config's alfa_dir, or the download)")
     fit.set_defaults(handler=_fit)
-    mon = commands.add_parser("monitor", help="run a model file on a MAVLink link or log")
+    mon = commands.add_parser("monitor", help="run a model file on a MAVLink link or log",
+                              **shown)
     mon.add_argument("model", help="a model file (alfa-bench fit)")
     mon.add_argument("source", help="a .tlog, udpin:0.0.0.0:14550, tcp:host:port, a serial "
                                     "device")
@@ -110,7 +126,8 @@ def main(argv: list[str] | None = None) -> int:
     mon.add_argument("--allow-actuators", action="store_true",
                      help="run a model that reads signals ALFA's fault emulation writes")
     mon.set_defaults(handler=_monitor)
-    rep = commands.add_parser("replay", help="write a flight as MAVLink to a .tlog or link")
+    rep = commands.add_parser("replay", help="write a flight as MAVLink to a .tlog or link",
+                              **shown)
     rep.add_argument("flight", help="a flight of the corpus, by name")
     rep.add_argument("-o", "--output", required=True,
                      help="a .tlog to write, or a link (udpout:127.0.0.1:14550)")
@@ -123,7 +140,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return args.handler(args)
     except (KeyError, ValueError, OSError) as e:
-        print(f"alfa-bench {args.command}: {e}", file=sys.stderr)
+        # a KeyError's str() is its repr: print the message
+        message = e.args[0] if isinstance(e, KeyError) and e.args else e
+        print(f"alfa-bench {args.command}: {message}", file=sys.stderr)
         return 1
 
 

@@ -35,6 +35,7 @@ import json
 import math
 import os
 import zipfile
+import zlib
 from collections import deque
 from pathlib import Path
 
@@ -182,7 +183,7 @@ def load_model(path: str | os.PathLike) -> tuple[Detector, dict]:
     try:
         with np.load(path, allow_pickle=False) as archive:
             arrays = {name: archive[name] for name in archive.files}
-    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as e:
+    except (OSError, ValueError, zipfile.BadZipFile, EOFError, zlib.error) as e:
         raise ModelFileError(f"{path}: not a readable model file ({e})") from None
     try:
         document = arrays.pop("model.json").tobytes()

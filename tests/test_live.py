@@ -126,10 +126,13 @@ def test_a_stamp_a_little_early_is_redated_a_late_one_dropped_a_clock_restart_re
     assert monitor.last_t == 10.0 and not monitor.dropped
     monitor.feed(9.5, "X", values)                     # half a second late: dropped
     assert monitor.dropped["out of order"] == 1
+    monitor.feed(1e9, "X", values)                     # one wild stamp: dropped
+    assert monitor.dropped["time jump, not confirmed"] == 1 and monitor.last_t == 10.0
     with caplog.at_level("WARNING"):
-        monitor.feed(2.0, "X", values)                 # a reboot: a new clock
-    assert "the clock went back 8.0 s; re-arming" in caplog.text
-    assert monitor.last_t == 2.0 and monitor.next_step == first_grid_step(2.0, det.rate_hz)
+        monitor.feed(2.0, "X", values)                 # a reboot: a new clock ...
+        monitor.feed(2.1, "X", values)                 # ... once confirmed
+    assert "the clock went back 7.9 s; re-arming" in caplog.text
+    assert monitor.last_t == 2.1 and monitor.next_step == first_grid_step(2.1, det.rate_hz)
     monitor.feed(float("nan"), "X", values)
     assert monitor.dropped["no time"] == 1
 
@@ -275,3 +278,22 @@ def test_a_fault_of_the_link_alone_raises_no_fault_alarm(fault, quiet_flight, tm
     assert monitor.steps > 0
     if FAULTS[fault]:
         assert FAULTS[fault] in caplog.text
+
+
+def test_the_command_names_a_missing_log_and_a_monitor_that_never_armed(
+        local, quiet_flight, tmp_path, capsys):
+    from alfa_bench import cli
+    from alfa_bench.methods.model_files import save_model
+
+    _, flight = quiet_flight
+    det = ab.fit_run("residual_logistic_published_date", local)
+    model = save_model(det, tmp_path / "m.abm", run="residual_logistic_published_date")
+    assert cli.main(["monitor", str(model), str(tmp_path / "nothere.tlog")]) == 1
+    assert "nothere.tlog: no such log, device or link" in capsys.readouterr().err
+    # a log holding only the IMU: the other signals never come
+    imu = [s for s in det.signals() if mavlink.FIELDS.get(s, None) is not None
+           and mavlink.FIELDS[s].message == "HIGHRES_IMU"]
+    replay.write_tlog(flight, tmp_path / "imu.tlog", imu)
+    assert cli.main(["monitor", str(model), str(tmp_path / "imu.tlog")]) == 1
+    err = capsys.readouterr().err
+    assert "never armed: no message gave" in err and "roll" in err

@@ -92,6 +92,15 @@ def test_an_altered_file_is_refused_by_its_digest(saved, tmp_path):
         load_model(tmp_path / "doc.abm")
 
 
+def test_a_byte_flipped_in_the_archive_is_a_named_error(saved, tmp_path):
+    data = bytearray(saved["residual_bank"].read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    (tmp_path / "flip.abm").write_bytes(bytes(data))
+    with pytest.raises(ModelFileError, match="flip.abm: (not a readable model file|its "
+                                             "content does not match)"):
+        load_model(tmp_path / "flip.abm")
+
+
 def test_a_state_altered_and_signed_again_is_not_the_fit_saved(saved, tmp_path):
     members = _members(saved["coincidence"])
     body = _document(members)

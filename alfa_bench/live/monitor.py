@@ -129,9 +129,10 @@ class Monitor:
 
     The input's state is named in the log when it changes (:attr:`state`): waiting for
     every signal, armed, a value out of the signal's physical bounds (dropped, the last
-    plausible one held), a signal stale (re-arming). A message older than one taken
-    (a clock jump back, a reordered packet) is dropped; :attr:`dropped` counts each
-    kind. A lost or duplicated message changes nothing but the freshness it carried.
+    plausible one held), a signal stale (re-arming), the clock gone back (re-arming). A
+    message more than ``stale_s`` away from the last one taken is dropped unless the
+    next confirms the jump; one earlier than the last taken is dropped (up to
+    :data:`REORDER_S` earlier it is re-dated); :attr:`dropped` counts each kind.
     """
 
     def __init__(self, detector: Detector, allow_actuators: bool = False,
@@ -154,6 +155,7 @@ class Monitor:
         self.stale_s = stale_s
         self.next_step: int | None = None
         self.last_t = -math.inf
+        self.jump_to: float | None = None
         self.state = "waiting for every signal"
         self.dropped: Counter = Counter()
         self.prev_source = {n: -1 for n in self.measured}
@@ -162,6 +164,10 @@ class Monitor:
         self.first_alarm: Decision | None = None
         self.alarming: set[str] = set()
         self.origin_s: float | None = None
+
+    def missing(self) -> list[str]:
+        """The measured signals no message has given yet."""
+        return [n for n, r in self.records.items() if not r.count]
 
     @property
     def armed(self) -> bool:
@@ -176,10 +182,18 @@ class Monitor:
         if not math.isfinite(t):
             self.dropped["no time"] += 1
             return []
-        if t < self.last_t - self.stale_s:   # the source's clock started again
-            self._rearm([], t, f"the clock went back {self.last_t - t:.1f} s")
-            self.last_t = t
-        elif t < self.last_t - REORDER_S:
+        if math.isfinite(self.last_t) and abs(t - self.last_t) > self.stale_s:
+            # a jump is taken once the next message confirms it: a single wild stamp (a
+            # log's unprotected timestamp, a corrupt field) is dropped
+            if self.jump_to is None or abs(t - self.jump_to) > self.stale_s:
+                self.jump_to = t
+                self.dropped["time jump, not confirmed"] += 1
+                return []
+            if t < self.last_t:         # the source's clock started again
+                self._rearm([], t, f"the clock went back {self.last_t - t:.1f} s")
+                self.last_t = t
+        self.jump_to = None
+        if t < self.last_t - REORDER_S:
             self.dropped["out of order"] += 1
             self._set_state("out of order: messages earlier than one taken are dropped",
                             self.last_t)
@@ -279,6 +293,8 @@ def watch(source: str, monitor: Monitor, clock: str | None = None,
     from pymavlink import mavutil
 
     is_file = Path(source).is_file()
+    if not is_file and ":" not in source and not Path(source).exists():
+        raise FileNotFoundError(f"{source}: no such log, device or link")
     clock = clock or ("log" if is_file else "link")
     conn = mavutil.mavlink_connection(source, robust_parsing=True, dialect="ardupilotmega")
     sock = getattr(conn, "port", None)
