@@ -72,39 +72,24 @@ def _stream(message: str, times: np.ndarray, held: dict) -> Iterator[tuple[float
 
 
 def _build(mav, t: float, message: str, values: dict):
+    """The pymavlink message of type ``message`` at ``t`` (its time fields the flight
+    clock) whose fields give ``values``; a field the map does not set is 0."""
+    from pymavlink.dialects.v20 import ardupilotmega
+
     fields = mavlink.encode(message, values)
-    cls = getattr(mav, f"{message.lower()}_encode")
-    names = _field_names(mav, message)
-    clock = {"time_boot_ms": int(round(t * 1e3)), "time_usec": int(round(t * 1e6))}
-    args = [clock[n] if n in clock else _cast(mav, message, n, fields.get(n, 0))
-            for n in names]
-    return cls(*args)
-
-
-def _field_names(mav, message: str) -> list[str]:
-    from pymavlink.dialects.v20 import ardupilotmega
-
-    return list(getattr(ardupilotmega, f"MAVLink_{message.lower()}_message").fieldnames)
-
-
-def _cast(mav, message: str, name: str, value: float):
-    from pymavlink.dialects.v20 import ardupilotmega
-
     cls = getattr(ardupilotmega, f"MAVLink_{message.lower()}_message")
-    kind = dict(zip(cls.fieldnames, cls.fieldtypes, strict=True))[name]
-    if kind.startswith(("int", "uint")):
-        return int(round(value))
-    return float(value)
+    clock = {"time_boot_ms": int(round(t * 1e3)), "time_usec": int(round(t * 1e6))}
+    args = [clock[n] if n in clock else
+            int(round(fields.get(n, 0))) if kind.startswith(("int", "uint")) else
+            float(fields.get(n, 0))
+            for n, kind in zip(cls.fieldnames, cls.fieldtypes, strict=True)]
+    return getattr(mav, f"{message.lower()}_encode")(*args)
 
 
 def _encoder():
     from pymavlink.dialects.v20 import ardupilotmega
 
-    class _Sink:
-        def write(self, b):
-            pass
-
-    return ardupilotmega.MAVLink(_Sink(), srcSystem=1, srcComponent=1)
+    return ardupilotmega.MAVLink(None, srcSystem=1, srcComponent=1)
 
 
 def packets(flight: Flight, signals=None) -> Iterator[tuple[float, bytes]]:
