@@ -54,11 +54,10 @@ import copy
 import functools
 import hashlib
 import inspect
-import json
 import logging
 import math
 from abc import ABC, abstractmethod
-from collections import OrderedDict, deque
+from collections import deque
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -201,19 +200,21 @@ def json_ready(value):
     return repr(value)
 
 
-def source_digest(cls: type) -> str:
-    """A digest of the code of ``cls`` and of its bases outside alfa-bench: the source
-    where it can be read, else each function's bytecode and constants (a class typed
-    into a notebook)."""
+def source_digest(cls: type, package: bool = False) -> str:
+    """A digest of the code of ``cls`` and of its bases outside alfa-bench (with
+    ``package``, alfa-bench's own too): the source where it can be read, else each
+    function's bytecode and constants (a class typed into a notebook; a sealed fit's
+    own, :func:`_sealed`)."""
+    skipped = ("builtins", "abc") if package else ("alfa_bench", "builtins", "abc")
     h = hashlib.blake2b(digest_size=16)
     for c in cls.__mro__:
-        if c.__module__.split(".")[0] in ("alfa_bench", "builtins", "abc"):
+        if c.__module__.split(".")[0] in skipped:
             continue
         try:
             h.update(inspect.getsource(c).encode())
         except (OSError, TypeError):
             for name, f in sorted(vars(c).items()):
-                code = getattr(f, "__code__", None)
+                code = getattr(getattr(f, "__wrapped__", f), "__code__", None)
                 if code is not None:
                     h.update(name.encode() + code.co_code + repr(code.co_consts).encode())
     return h.hexdigest()
@@ -800,54 +801,6 @@ def segment_digest(s: Sampled | Labelled) -> bytes:
     for a in (s.t, s.x, s.fresh):
         h.update(np.ascontiguousarray(a).data)
     return h.digest()
-
-
-#: the models fitted in this process (what :func:`kept_fit` keeps), by the detector's
-#: class, its hyper-parameters but the threshold's, and the digest of every training
-#: segment; the :data:`MODEL_FITS_KEPT` last used are kept
-MODEL_FITS: OrderedDict[tuple, dict] = OrderedDict()
-MODEL_FITS_KEPT = 256
-
-
-def plain_data(value) -> bool:
-    """Whether ``value`` is data alone (numbers, strings, None, and lists, tuples and
-    string-keyed dicts of them), which JSON writes whole."""
-    if value is None or isinstance(value, str | int | float | bool):
-        return True
-    if isinstance(value, list | tuple):
-        return all(map(plain_data, value))
-    if isinstance(value, dict):
-        return all(isinstance(k, str) and plain_data(v) for k, v in value.items())
-    return False
-
-
-def kept_fit(detector: Detector, segments: list, fit, state: tuple[str, ...]) -> None:
-    r"""``fit(segments)``, which sets ``detector``'s learned attributes ``state``, or
-    those attributes as a fit of the same class with the same hyper-parameters (the
-    threshold's aside) on the same data left them, kept in :data:`MODEL_FITS`.
-
-    Nested selection fits a candidate without the same dates again and again (the
-    out-of-sample maxima of its inner fit without :math:`d` and of the one without
-    :math:`e` both need the model without :math:`\{d, e\}`, and later scored dates'
-    folds again), and fits are deterministic. Only a detector whose hyper-parameters
-    are plain data (:func:`plain_data`) is kept: an estimator object may change after
-    the fit. A kept fit is restored in the order the fit set its attributes, as the
-    fit token (:func:`fit_token`) digests them in order."""
-    params = {k: v for k, v in detector.get_params().items()
-              if k not in detector.threshold_params}
-    key = None
-    if plain_data(params):
-        key = (type(detector).__qualname__, json.dumps(params, sort_keys=True),
-               tuple(map(segment_digest, segments)))
-    if key is not None and key in MODEL_FITS:
-        MODEL_FITS.move_to_end(key)
-        detector.__dict__.update(MODEL_FITS[key])
-        return
-    fit(segments)
-    if key is not None:
-        MODEL_FITS[key] = {n: v for n, v in vars(detector).items() if n in state}
-        while len(MODEL_FITS) > MODEL_FITS_KEPT:
-            MODEL_FITS.popitem(last=False)
 
 
 def leave_one_date_out(segments: list) -> list[tuple[str, list, list]]:

@@ -45,7 +45,8 @@ import numpy as np
 from alfa_bench.data import Sampled
 
 from . import physics
-from .base import Labelled, kept_fit
+from .base import Labelled
+from .fits import kept_fit
 from .residual_bank import ResidualBank
 from .residual_logistic import (
     INPUTS,
@@ -145,7 +146,7 @@ class BenchLogistic(ResidualLogistic):
 
     def fit_model(self, segments: list[Labelled]) -> BenchLogistic:
         """The study's fit over the blocks read, or the same fit from
-        :data:`~.base.MODEL_FITS` (:func:`~.base.kept_fit`): a nested selection asks for
+        :data:`~.fits.MODEL_FITS` (:func:`~.fits.kept_fit`): a nested selection asks for
         each candidate's fit without the same dates again and again."""
         kept_fit(self, segments, super().fit_model, self.model_state)
         return self

@@ -17,9 +17,10 @@ and raises ``AssertionError`` where the contract fails:
   ``reset`` forgets the previous flight; a run continued from a snapshot (forked)
   equals the run from t = 0; where hyper-parameters set only the thresholds,
   re-thresholding a fit for new values equals fitting with them;
-- a refit is a fresh fit: one instance fitted on other data, then on the check's,
-  gives what a new one fitted on the check's gives, and a state taken under the first
-  fit is refused under the second; per-flight maxima that do not vary give a
+- a refit is a fresh fit: one instance fitted on other data, then on the check's
+  (anew, not from the fits kept in the process before, :mod:`.fits`), gives what a new
+  one fitted on the check's gives, and a state taken under the first fit is refused
+  under the second; per-flight maxima that do not vary give a
   :class:`~.base.CalibrationError`, from the point fit and the pool fit alike, never
   an infinite or NaN threshold;
 - it is causal: changing the data after time *t* changes no output before *t*.
@@ -65,6 +66,7 @@ from .base import (
     training_segments,
 )
 from .extremes import MaximaThresholds
+from .fits import fresh_fits
 
 __all__ = ["CHECKS", "QUICK_CHECKS", "ContractError", "parametrize_with_checks",
            "quick_check"]
@@ -398,13 +400,16 @@ def check_rethreshold_equals_fit(detector: Detector) -> None:
                     f"other thresholds with {name} = {other!r}", "the same thresholds")
 
 
-@_check("let fit() learn from its data alone: start from nothing learned (the base "
-        "class forgets learned attributes; keep no other cache on the instance)")
+@_check("let fit() learn from its data alone, the same each time: start from nothing "
+        "learned (the base class forgets learned attributes; keep no other cache on the "
+        "instance), and seed every random draw from the parameters")
 def check_a_refit_is_a_fresh_fit(detector: Detector) -> None:
     """One instance fitted on other data (the corpus less two flights), run, then fitted
     on the check's, equals a new one fitted on the check's: what fit learned, its
-    :func:`~.base.fit_token` and the run. A state taken under the first fit is
-    refused under the second, where the two fits learned differently. An
+    :func:`~.base.fit_token` and the run. The refit is made anew
+    (:func:`~.fits.fresh_fits`): a fit kept in the process before would be the other
+    one again, and hide a fit that is not deterministic. A state taken under the first fit
+    is refused under the second, where the two fits learned differently. An
     uncalibrated detector has nothing to check."""
     if not detector.calibrated:
         return
@@ -416,7 +421,8 @@ def check_a_refit_is_a_fresh_fit(detector: Detector) -> None:
     else:
         run_detector(d, _flight())
         first = fit_token(d), forks(d, _flight(), [0.5 * _flight().duration_s])
-    _fit(d)
+    with fresh_fits():
+        _fit(d)
     fresh = _fitted(detector)
     _expect(d.fitted() == fresh.fitted(), f"a refit to learn what a fresh fit learns: "
             f"{fresh.fitted()}", d.fitted())

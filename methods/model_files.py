@@ -14,17 +14,23 @@ attribute ending in ``_``, :func:`~.base.learned_state`) encoded as
   ``{"dict": {...}}``, other keys as ``{"pairs": [[key, value], ...]}``;
 - a numeric array or NumPy scalar as ``{"array": i}`` (``a<i>`` in the archive);
 - a detector held by another (a nested selection's base, a classifier's residual bank)
-  as ``{"detector": name, "params": ..., "state": ...}``, built again from the
-  registry.
+  as ``{"detector": name, "params": ..., "state": ..., "source": ...}``, built again
+  from the registry.
+
+Each detector, the saved one and those it holds, records the digest of its class's
+code (``source``: :func:`~.base.source_digest`, alfa-bench's own bases included).
 
 Anything else (a library's estimator object, an object array) is refused when saving,
 naming the attribute. Loading reads the archive with ``allow_pickle=False``, checks a
 SHA-256 over the document and every array, the format and the package version, builds
 the detector from the registry by name, sets its learned state (names ending in ``_``
 only) and checks that its fit token is the one saved: the detector is the fitted one,
-by value, or the load fails. The digests are in the file: they catch a damaged file or
-an edit that did not recompute them, not a forger; what holds against any file is
-that loading runs none of its code.
+by value, or the load fails. A detector whose code here is not the code that fitted
+it (its class edited since, within the same package version) is said so in a
+warning, naming it, and in what :func:`load_model` returns (``code_changed``): it
+loads, since its state is the one saved, but what it scores may differ. The digests
+are in the file: they catch a damaged file or an edit that did not recompute them,
+not a forger; what holds against any file is that loading runs none of its code.
 """
 
 from __future__ import annotations
@@ -32,6 +38,7 @@ from __future__ import annotations
 import hashlib
 import io
 import json
+import logging
 import math
 import os
 import zipfile
@@ -43,9 +50,11 @@ import numpy as np
 
 from alfa_bench.data import reads_actuators
 
-from .base import Detector, fit_token, learned_digest, learned_state
+from .base import Detector, fit_token, learned_digest, learned_state, source_digest
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "ModelFileError", "load_model", "save_model"]
+
+log = logging.getLogger(__name__)
 
 #: the format's name, in every file
 FORMAT = "alfa-bench model"
@@ -70,7 +79,8 @@ def _encode(value, arrays: list[np.ndarray], where: str):
     if isinstance(value, Detector):
         return {"detector": detector_name(value), "params": _encode(value.get_params(), arrays,
                                                                     f"{where}.params"),
-                "state": _encode(learned_state(value), arrays, f"{where}.state")}
+                "state": _encode(learned_state(value), arrays, f"{where}.state"),
+                "source": source_digest(type(value), package=True)}
     if isinstance(value, np.ndarray | np.generic):
         a = np.asarray(value)
         if a.dtype.hasobject or a.dtype.kind not in "biufc":
@@ -97,9 +107,11 @@ def _encode(value, arrays: list[np.ndarray], where: str):
                          "JSON")
 
 
-def _decode(value, arrays: dict[str, np.ndarray]):
+def _decode(value, arrays: dict[str, np.ndarray], changed: list[str]):
+    """``value`` as :func:`_encode` wrote it, decoded; the name of each detector built
+    whose code is not the code saved is appended to ``changed``."""
     if isinstance(value, list):
-        return [_decode(v, arrays) for v in value]
+        return [_decode(v, arrays, changed) for v in value]
     if not isinstance(value, dict):
         return value
     if "array" in value:
@@ -108,23 +120,27 @@ def _decode(value, arrays: dict[str, np.ndarray]):
     if "float" in value:
         return float(value["float"])
     if "tuple" in value:
-        return tuple(_decode(v, arrays) for v in value["tuple"])
+        return tuple(_decode(v, arrays, changed) for v in value["tuple"])
     if "deque" in value:
-        return deque((_decode(v, arrays) for v in value["deque"]), maxlen=value["maxlen"])
+        return deque((_decode(v, arrays, changed) for v in value["deque"]),
+                     maxlen=value["maxlen"])
     if "dict" in value:
-        return {k: _decode(v, arrays) for k, v in value["dict"].items()}
+        return {k: _decode(v, arrays, changed) for k, v in value["dict"].items()}
     if "pairs" in value:
-        return {_decode(k, arrays): _decode(v, arrays) for k, v in value["pairs"]}
+        return {_decode(k, arrays, changed): _decode(v, arrays, changed)
+                for k, v in value["pairs"]}
     if "detector" in value:
-        return _build(value, arrays)
+        return _build(value, arrays, changed)
     raise ValueError(f"unknown encoding {sorted(value)}")
 
 
-def _build(spec: dict, arrays: dict[str, np.ndarray]) -> Detector:
+def _build(spec: dict, arrays: dict[str, np.ndarray], changed: list[str]) -> Detector:
     from . import make_detector
 
-    detector = make_detector(spec["detector"], _decode(spec["params"], arrays))
-    for name, v in _decode(spec["state"], arrays).items():
+    detector = make_detector(spec["detector"], _decode(spec["params"], arrays, changed))
+    if spec.get("source") != source_digest(type(detector), package=True):
+        changed.append(spec["detector"])
+    for name, v in _decode(spec["state"], arrays, changed).items():
         if not name.endswith("_") or name.startswith("_"):
             raise ValueError(f"{name!r} is not a learned attribute")
         setattr(detector, name, v)
@@ -170,8 +186,10 @@ def save_model(detector: Detector, path: str | os.PathLike, *, run: str,
 
 def load_model(path: str | os.PathLike) -> tuple[Detector, dict]:
     """The fitted detector of the model file ``path``, and what the file says of it (its
-    run, config, data, version). Nothing in the file is run: arrays are read without
-    pickle, the detector is built by its registry name.
+    run, config, data, version, and ``code_changed``: the detectors, by registry name,
+    whose code differs from the code that fitted them, also said in a warning). Nothing
+    in the file is run: arrays are read without pickle, the detector is built by its
+    registry name.
 
     Raises
     ------
@@ -201,8 +219,9 @@ def load_model(path: str | os.PathLike) -> tuple[Detector, dict]:
     if body["version"] != _version():
         raise ModelFileError(f"{path}: written by alfa-bench {body['version']}, this is "
                              f"{_version()}: fit the run again with this version")
+    changed: list[str] = []
     try:
-        detector = _build(body["model"], arrays)
+        detector = _build(body["model"], arrays, changed)
     except KeyError as e:
         raise ModelFileError(f"{path}: detector {body['model'].get('detector')!r} is not "
                              f"registered here ({e})") from None
@@ -211,4 +230,9 @@ def load_model(path: str | os.PathLike) -> tuple[Detector, dict]:
     if learned_digest(detector) != detector.fit_digest_ or fit_token(detector) != body[
             "fit_token"]:
         raise ModelFileError(f"{path}: the state loaded does not give the fit saved")
-    return detector, {k: v for k, v in body.items() if k != "model"}
+    if changed:
+        log.warning("%s: the code of %s is not the code that fitted it (edited since): "
+                    "it loads, but may score otherwise; fit the run again to be sure",
+                    path, ", ".join(dict.fromkeys(changed)))
+    return detector, {**{k: v for k, v in body.items() if k != "model"},
+                      "code_changed": list(dict.fromkeys(changed))}

@@ -38,7 +38,8 @@ held out, and scoring :math:`d` with :math:`o` held out. Each inner fit is there
 kept, keyed by the candidate and the exact data it was fitted on (a digest of every
 segment's samples), and given again when the same data comes back; fits are
 deterministic, so this changes no result, and halves the inner fits. They are kept for
-the process (:data:`INNER_FITS`), not in the detector: each fold fits a clone of it,
+the process (:data:`INNER_FITS`, keyed by the candidate's code and hyper-parameters and
+its data, :func:`~.fits.fit_key`), not in the detector: each fold fits a clone of it,
 and a fit starts from nothing (:meth:`~.base.Detector.fit`). Candidates that
 differ only in hyper-parameters that set the thresholds
 (:attr:`~.base.Detector.threshold_params`, such as a false-alarm rate) give the same
@@ -50,7 +51,6 @@ from __future__ import annotations
 
 import copy
 import itertools
-import json
 import logging
 
 import numpy as np
@@ -65,17 +65,19 @@ from .base import (
     clone,
     free_part,
     leave_one_date_out,
-    segment_digest,
 )
+from .fits import KeptFits, fit_key, segments_data
 
 __all__ = ["INNER_FITS", "NestedSelection", "held_out_right"]
 
 log = logging.getLogger(__name__)
 
-#: every inner fit made in this process (the fitted detector, or the
-#: :class:`~.base.CalibrationError` it could not be fitted with), by the selection's
-#: hyper-parameters, the candidate and the digest of its data
-INNER_FITS: dict[tuple, Detector | CalibrationError] = {}
+#: the inner fits made in this process (the fitted detector, or the
+#: :class:`~.base.CalibrationError` it could not be fitted with), by the candidate's
+#: code and hyper-parameters and its data (:func:`~.fits.fit_key`): the 256 last used,
+#: twice the distinct inner fits of the workflow's largest run (12 candidates, each
+#: without every pair of ALFA's 5 dates)
+INNER_FITS = KeptFits(256)
 
 
 def _sharing(made: list[Detector]) -> list[list[int]]:
@@ -215,14 +217,14 @@ class NestedSelection(Detector):
         if len(folds) < 2:
             raise CalibrationError(f"nested selection needs training flights of two dates or "
                                    f"more; found {len(folds)}")
-        digest = {id(f): segment_digest(f) for f in segments}
+        digest = dict(zip(map(id, segments), segments_data(segments), strict=True))
         candidates, groups = self.candidates(), _sharing(made)
         tally = [{"scored": 0, "right": 0, "unfit": []} for _ in made]
         for d, training, held in folds:
             held = [f for f in held if self._scored(f)]
             if not held:
                 continue
-            data = tuple(digest[id(f)] for f in training)
+            data = [digest[id(f)] for f in training]
             for group in groups:
                 fits = {i: self._inner_fit(i, group[0], made, data, training) for i in group}
                 for i in group:
@@ -261,29 +263,38 @@ class NestedSelection(Detector):
                  inner[best]["scored"], len(inner))
         return self
 
-    def _inner_fit(self, i: int, first: int, made: list[Detector], data: tuple,
+    def _inner_fit(self, i: int, first: int, made: list[Detector], data: list[str],
                    training: list[Labelled]) -> Detector | CalibrationError:
-        """Candidate ``i`` fitted on ``training`` (whose digest is ``data``), or the
-        :class:`~.base.CalibrationError` it cannot be fitted with; kept in
+        """Candidate ``i`` fitted on ``training`` (whose segments' digests are ``data``),
+        or the :class:`~.base.CalibrationError` it cannot be fitted with; kept in
         :data:`INNER_FITS`. A candidate that differs from candidate ``first`` of its
         group in :attr:`~.base.Detector.threshold_params` alone is that fit,
         re-thresholded."""
-        kept, selection = INNER_FITS, json.dumps(self.get_params(), sort_keys=True)
-        key = (selection, i, data)
-        if key in kept:
-            return kept[key]
-        shared = kept.get((selection, first, data)) if i != first else None
+        key = self._inner_key(made[i], data)
+        fit = INNER_FITS.get(key)
+        if fit is not None:
+            return fit
+        shared = INNER_FITS.get(self._inner_key(made[first], data)) if i != first else None
         try:
             if shared is None or isinstance(shared, CalibrationError):
-                kept[key] = clone(made[i]).fit(self._training(made[i], training))
+                fit = clone(made[i]).fit(self._training(made[i], training))
             else:
-                det = copy.deepcopy(shared)
-                for name in type(det).threshold_params:
-                    setattr(det, name, getattr(made[i], name))
-                kept[key] = det.rethreshold()
+                fit = copy.deepcopy(shared)
+                for name in type(fit).threshold_params:
+                    setattr(fit, name, getattr(made[i], name))
+                fit.rethreshold()
         except CalibrationError as e:   # too little data without the date: it goes unscored
-            kept[key] = e
-        return kept[key]
+            fit = e
+        INNER_FITS.put(key, fit)
+        return fit
+
+    def _inner_key(self, candidate: Detector, data: list[str]) -> str | None:
+        """The key of ``candidate``'s fit on the training flights whose digests are
+        ``data``: those labelled flights if it is supervised, else their fault-free
+        parts less ``margin_s`` (:meth:`_training`)."""
+        if not candidate.supervised:
+            data = {"fault_free_before_onset_less_s": self.margin_s, "of": data}
+        return fit_key(candidate, data)
 
     def fitted(self) -> dict:
         self._check_fitted("base_")

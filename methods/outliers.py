@@ -58,10 +58,10 @@ from .base import (
     StaleStateError,
     fit_token,
     json_ready,
-    kept_fit,
     leave_one_date_out,
 )
 from .extremes import MaximaThresholds
+from .fits import kept_fit
 from .residual_logistic import INPUTS as RESIDUAL_INPUTS
 from .residual_logistic import (
     LONGEST_WINDOW_S,
@@ -270,7 +270,7 @@ class OutlierModel(MaximaThresholds, Detector):
     def fit_model(self, segments: list[Sampled]) -> OutlierModel:
         """Scale the training rows' features and fit the model on them (at most
         ``max_rows``, evenly spaced), or take the same fit from
-        :data:`~.base.MODEL_FITS` (:func:`~.base.kept_fit`; the fits are deterministic:
+        :data:`~.fits.MODEL_FITS` (:func:`~.fits.kept_fit`; the fits are deterministic:
         a seed is set)."""
         kept_fit(self, segments, self._fit_rows, self.model_state)
         return self

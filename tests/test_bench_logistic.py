@@ -8,7 +8,7 @@ from config_runs import CONFIG
 
 from alfa_bench.data import Sampled
 from alfa_bench.data.flight import parse_flight_name
-from alfa_bench.methods import base, labelled_segments, make_detector, physics
+from alfa_bench.methods import base, fits, labelled_segments, make_detector, physics
 from alfa_bench.methods.bench_logistic import BenchLogistic
 from alfa_bench.methods.nested_selection import INNER_FITS
 
@@ -32,7 +32,7 @@ def test_the_nested_run_fits_each_candidate_on_labelled_flights_of_other_dates(
     flights = list(corpus_flights.values())
     training = labelled_segments(nested, flights)
     INNER_FITS.clear()
-    base.MODEL_FITS.clear()
+    fits.MODEL_FITS.clear()
     nested.fit(training)
     assert all(isinstance(s, base.Labelled) for segs in seen for s in segs)
     assert any(s.onset_s is not None for segs in seen for s in segs)
@@ -46,15 +46,26 @@ def test_the_nested_run_fits_each_candidate_on_labelled_flights_of_other_dates(
 
 
 def test_a_kept_classifier_fit_is_the_fresh_fit(corpus_flights):
-    """A fit taken from MODEL_FITS is the fresh fit, token and all; a flight labelled
-    otherwise is other data, not the same fit."""
-    d = BenchLogistic(features=("study", "bank", "physics"))
-    segments = labelled_segments(d, list(corpus_flights.values()))
-    base.MODEL_FITS.clear()
-    fresh = BenchLogistic(features=("study", "bank", "physics")).fit(segments)
-    kept = BenchLogistic(features=("study", "bank", "physics")).fit(segments)
-    assert list(vars(kept)) == list(vars(fresh))
-    assert kept.snapshot() == fresh.snapshot()
+    """Two classifier fits made anew learn the same, and a fit taken from MODEL_FITS is
+    a fresh fit, token and all; a flight labelled otherwise is other data, not the same
+    fit."""
+    features = ("study", "bank", "physics")
+    segments = labelled_segments(BenchLogistic(features=features), list(corpus_flights.values()))
+    with fits.fresh_fits():
+        one = BenchLogistic(features=features).fit(segments)
+    with fits.fresh_fits():
+        two = BenchLogistic(features=features).fit(segments)
+    assert list(vars(one)) == list(vars(two))
+    assert base.learned_digest(one) == base.learned_digest(two)
+    assert base.fit_token(one) == base.fit_token(two)
+    fits.MODEL_FITS.clear()
+    BenchLogistic(features=features).fit(segments)
+    made = len(fits.MODEL_FITS)              # the model, and those of its inner folds
+    kept = BenchLogistic(features=features).fit(segments)
+    assert len(fits.MODEL_FITS) == made > 0
+    assert list(vars(kept)) == list(vars(one))
+    assert base.learned_digest(kept) == base.learned_digest(one)
+    assert base.fit_token(kept) == base.fit_token(one)
     faulty = next(i for i, s in enumerate(segments) if s.onset_s is not None)
     moved = list(segments)
     moved[faulty] = base.Labelled(segments[faulty].sampled, segments[faulty].onset_s + 1.0,

@@ -133,6 +133,26 @@ def test_another_version_or_an_unknown_detector_is_refused(saved, tmp_path, monk
         load_model(saved["coincidence"])
 
 
+def test_a_detector_fitted_by_other_code_loads_and_says_so(saved, tmp_path, caplog):
+    """Each detector in a file records its class's code digest; one whose code here is
+    not that code (edited since the fit) still loads, and the load names it, in a
+    warning and in ``code_changed``."""
+    for run in ("coincidence", "coincidence_nested"):
+        with caplog.at_level("WARNING"):
+            assert load_model(saved[run])[1]["code_changed"] == []
+        assert "not the code that fitted it" not in caplog.text
+    members = _members(saved["coincidence_nested"])
+    body = _document(members)
+    assert body["model"]["source"] and body["model"]["state"]["dict"]["base_"]["source"]
+    body["model"]["state"]["dict"]["base_"]["source"] = "0" * 32     # the base edited
+    _write(tmp_path / "edited.abm", _with_document(members, body, resign=True))
+    with caplog.at_level("WARNING"):
+        detector, about = load_model(tmp_path / "edited.abm")
+    assert about["code_changed"] == ["coincidence"]
+    assert "edited.abm: the code of coincidence is not the code that fitted it" in caplog.text
+    assert detector.fitted() == load_model(saved["coincidence_nested"])[0].fitted()
+
+
 class _Marker:
     """Unpickled, it writes a file: what a bare pickle would run on load."""
 

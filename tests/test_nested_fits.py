@@ -77,7 +77,7 @@ def test_a_generic_model_is_fitted_once_per_candidate_and_dates(corpus_flights, 
     """Nested selection of a PyOD model fits it on each set of dates inside the
     out-of-sample maxima of several larger sets: each such fit is made once
     (MODEL_FITS), and the choice, maxima and thresholds are those of fitting each anew."""
-    from alfa_bench.methods import base, outliers
+    from alfa_bench.methods import fits, outliers
 
     spec = CONFIG["methods"]["pyod_knn_nested"]
     grid = {"window_s": [1.0], "params": [{"n_neighbors": 3}, {"n_neighbors": 5}]}
@@ -90,16 +90,16 @@ def test_a_generic_model_is_fitted_once_per_candidate_and_dates(corpus_flights, 
     def fitted() -> dict:
         nested = make_detector(spec["detector"], {**spec["params"], "grid": grid})
         INNER_FITS.clear()
-        base.MODEL_FITS.clear()
+        fits.MODEL_FITS.clear()
         calls.clear()
         return nested.fit(labelled_segments(nested, flights)).fitted()
 
     kept = fitted()
     made = len(calls)
-    monkeypatch.setattr(base, "MODEL_FITS_KEPT", 0)
+    monkeypatch.setattr(fits.MODEL_FITS, "kept", 0)
     assert fitted() == kept
     assert 0 < made < len(calls)
-    assert not base.MODEL_FITS
+    assert not len(fits.MODEL_FITS)
 
 
 def test_a_candidate_never_fitted_is_recorded_unscored_in_valid_json(corpus_flights):
