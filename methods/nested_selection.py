@@ -183,6 +183,38 @@ class NestedSelection(Detector):
     def channel_outputs(self) -> tuple[str, ...]:
         return self._reference().channel_outputs()
 
+    def check_params(self) -> None:
+        """The base detector is registered, ``params`` and ``grid`` name its
+        hyper-parameters only (the grid a list of values for each), and every candidate
+        builds, keeps the base's signals, channels and rate, and passes the base's own
+        :meth:`~.base.Detector.check_params`: a nested run that cannot be fitted is
+        refused by the dry run, not in its job. Each error names the base and the key."""
+        from . import make_detector  # the registry imports this module
+
+        where = f"nested selection of {self.detector!r}"
+        try:
+            names = make_detector(self.detector).param_names()
+        except KeyError as e:
+            raise ValueError(f"{where}: detector: {e.args[0]}") from None
+        for part, keys in (("params", self.params or {}), ("grid", self.grid or {})):
+            unknown = [k for k in keys if k not in names]
+            if unknown:
+                raise ValueError(f"{where}: {part} key {unknown[0]!r} is not a "
+                                 f"hyper-parameter of {self.detector!r}; it has {names}")
+        for key, values in (self.grid or {}).items():
+            if not isinstance(values, list) or not values:
+                raise ValueError(f"{where}: grid key {key!r} must list its candidate values "
+                                 f"(YAML [a, b, ...]); got {values!r}")
+        try:
+            made = self._check_grid()
+        except TypeError as e:
+            raise ValueError(f"{where}: grid: {e}") from None
+        for values, candidate in zip(self.candidates(), made, strict=True):
+            try:
+                candidate.check_params()
+            except ValueError as e:
+                raise ValueError(f"{where}: grid candidate {values}: {e}") from None
+
     def _check_grid(self) -> list[Detector]:
         candidates = self.candidates()
         if not candidates:

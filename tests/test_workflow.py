@@ -406,6 +406,10 @@ def test_small_and_one_sided_flight_sets_run_to_the_end(specs, why, tmp_path):
      "config methods.x: detector 'rls_arx_zscore' has no parameter 'zthreshold'"),
     ("methods: {x: {detector: pyod, params: {model: IsolationTree}}}",
      "config methods.x: pyod model 'IsolationTree' with params {} cannot be built"),
+    ("methods: {x: {detector: nested_selection, params: {detector: pyod, params: {model: "
+     "HBOS}, grid: {params: [{n_bins: 5}, {n_binz: 10}]}}}}",
+     "config methods.x: nested selection of 'pyod': grid candidate {'params': {'n_binz': "
+     "10}}: pyod model 'HBOS'"),
     ("methods: {x: {detector: residual_logistic, calibration: {group_by: recording}}}",
      "config methods.x: calibration.group_by: recording lets flights of the scored date "
      "train it, so it can only be a reference row (role: reference)"),
