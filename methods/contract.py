@@ -23,7 +23,9 @@ and raises ``AssertionError`` where the contract fails:
   under the second; per-flight maxima that do not vary give a
   :class:`~.base.CalibrationError`, from the point fit and the pool fit alike, never
   an infinite or NaN threshold;
-- it is causal: changing the data after time *t* changes no output before *t*.
+- it is causal: changing the data after time *t* changes no output before *t*; and
+  changes some after it (scores the data does not reach are named as such, not as a
+  look-ahead).
 
 A plugin's own tests run them all with one decorator::
 
@@ -135,6 +137,29 @@ def _expect(ok, expected: str, got) -> None:
         raise AssertionError(f"expected {expected}; got {got}")
 
 
+class _Advice(AssertionError):
+    """A check's failure that calls for other advice than the check's own: ``todo``."""
+
+    def __init__(self, said: str, todo: str):
+        super().__init__(said)
+        self.todo = todo
+
+
+#: what to do about scores the data does not reach
+_READ_THE_DATA = ("its scores do not depend on the data: compute each step's score from "
+                  "the signals it reads (a score the data cannot change cannot detect a "
+                  "fault), and check that update() does not return NaN on every step")
+
+
+def _expect_the_data_reaches(a: np.ndarray, b: np.ndarray, where: str) -> None:
+    """Fail the check, with :data:`_READ_THE_DATA`, where the scores ``a`` of the check
+    flight equal those ``b`` of the flight with its data changed ``where``: no other
+    check of the run could fail then."""
+    if np.array_equal(a, b, equal_nan=True):
+        raise _Advice(f"expected scores that change {where} where the data does; got the "
+                      "same scores (is every score NaN or constant?)", _READ_THE_DATA)
+
+
 def _check(todo: str):
     """A contract check whose failure says which check it is, what it expected, what came
     back, and ``todo``: what to do about it (never an empty message)."""
@@ -147,8 +172,8 @@ def _check(todo: str):
                 check(detector)
             except AssertionError as e:
                 said = str(e).strip() or "a condition failed without a message"
-                raise AssertionError(f"contract check {name}: {said}\nWhat to do: {todo}"
-                                     ) from e
+                raise AssertionError(f"contract check {name}: {said}\nWhat to do: "
+                                     f"{getattr(e, 'todo', todo)}") from e
         return checked
     return wrap
 
@@ -342,8 +367,8 @@ def check_forked_run_equals_run(detector: Detector) -> None:
                                        rtol=1e-9, atol=1e-9,
                                        err_msg=f"the forked run's probe {name} differs")
     # the scrambled data must reach the detector, or the fork could not differ
-    _expect(not np.array_equal(whole.score, run_detector(d, flight).score, equal_nan=True),
-            "scores that change where the flight's data changes", "the same scores")
+    _expect_the_data_reaches(whole.score, run_detector(d, flight).score,
+                             f"after {cut_s:.1f} s")
 
 
 @_check("make a run_many() of its own give each item's run() (or remove it)")
@@ -556,9 +581,8 @@ def check_causal(detector: Detector) -> None:
     _assert_same(base, changed, upto=before,
                  what=f"with the data changed after {cut_s:.1f} s, the outputs before it")
     # the alteration must reach the detector, or this check could not fail
-    _expect(not np.array_equal(base.score[before:], changed.score[before:], equal_nan=True),
-            f"scores that change after {cut_s:.1f} s where the data does",
-            "the same scores (is every score NaN?)")
+    _expect_the_data_reaches(base.score[before:], changed.score[before:],
+                             f"after {cut_s:.1f} s")
 
 
 #: every check, in the order they run

@@ -165,3 +165,22 @@ def test_a_detector_the_corpus_cannot_calibrate_is_still_checked(caplog):
     (said,) = [r.getMessage() for r in caplog.records if "left to the real flights" in
                r.getMessage()]
     assert "outputs_have_the_declared_shape" in said and "causal" not in said, said
+
+
+class Constant(Sound):
+    """Scores the same whatever the data: causal, but blind to it."""
+
+    def update(self, x, fresh):
+        return np.array([1.0])
+
+
+def test_a_constant_score_is_told_it_ignores_the_data_not_that_it_looks_ahead():
+    with pytest.raises(ContractError) as e:
+        quick_check(Constant())
+    said = str(e.value)
+    assert "contract check causal: " in said and "do not depend on the data" in said, said
+    assert "no look-ahead" not in said, said
+    # a detector that looks ahead is still told so
+    with pytest.raises(ContractError) as e:
+        quick_check(LooksAhead())
+    assert "no look-ahead" in str(e.value) and "do not depend" not in str(e.value)
