@@ -8,7 +8,9 @@ the record before the previous step's. The grid is :math:`k / f` on the source's
 (``f`` the detector's rate) from the first step at which every signal has a record; a
 step is decided once a message later than it arrives (no record for it can come after).
 Each step feeds :meth:`~alfa_bench.methods.Detector.update`; a channel whose score
-exceeds its threshold is an alarm (:class:`Decision`).
+exceeds its threshold is an alarm (:class:`Decision`). A channel reading a sensor that
+has not moved since arming is not scored (NaN) until it does, by the batch run's rule
+(:class:`~alfa_bench.methods.UnmovedSensors`).
 
 The clock (:func:`message_time`) is a log's timestamp (``clock="log"``, a ``.tlog``) or
 the messages' own time fields (``clock="link"``): ``time_usec``, ``time_boot_ms``, a
@@ -30,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from alfa_bench.data import MAX_HOLD_S, SIGNALS, first_grid_step, hold
-from alfa_bench.methods import Detector
+from alfa_bench.methods import Detector, UnmovedSensors
 
 from . import mavlink
 
@@ -144,6 +146,7 @@ class Monitor:
                              "emulation, not measured: refused for a live link unless "
                              "allowed explicitly")
         self.detector = detector.reset()
+        self.unmoved = UnmovedSensors(detector)
         self.names = tuple(names)
         self.measured = mavlink.fields_for(names)
         self.records = {n: _Records() for n in self.measured}
@@ -246,6 +249,7 @@ class Monitor:
         why = why or f"stale: {', '.join(stale)} held over {self.stale_s:g} s"
         self._set_state(f"{why}; re-arming", t_step)
         self.detector.reset()
+        self.unmoved = UnmovedSensors(self.detector)
         self.records = {n: _Records() for n in self.measured}
         self.prev_source = {n: -1 for n in self.measured}
         self.next_step = None
@@ -265,7 +269,12 @@ class Monitor:
                       if n in mavlink.DIFFERENCES else held[n] for n in self.names])
         f = np.array([fresh[mavlink.DIFFERENCES[n][0]] if n in mavlink.DIFFERENCES
                       else fresh[n] for n in self.names])
-        score = np.asarray(self.detector.update(x, f), dtype=float)
+        score = np.array(self.detector.update(x, f), dtype=float)
+        was = self.unmoved.unmoved()
+        score[self.unmoved.blanked(x[None, :])[0]] = np.nan
+        if self.unmoved.unmoved() != was:
+            log.info("not scored while unmoved since arming: %s at t=%.2f s",
+                        ", ".join(self.unmoved.unmoved()) or "none", t_step)
         alarm = self.detector.alarms(score[None, :])[0]
         decision = Decision(t_step, dict(zip(self.channels, map(float, score), strict=True)),
                             self.thresholds,
