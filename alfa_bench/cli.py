@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
+from pathlib import Path
 
 
 def _fit(args: argparse.Namespace) -> int:
@@ -59,10 +60,11 @@ def _monitor(args: argparse.Namespace) -> int:
             last[:] = [now, monitor.messages]
         return False
 
+    interrupted = False
     try:
         watch(args.source, monitor, clock=args.clock, stop=progress)
     except KeyboardInterrupt:
-        pass
+        interrupted = True
     first = monitor.first_alarm
     if not monitor.steps:
         print(f"{about['run']}: {monitor.messages} messages, never armed: no message gave "
@@ -71,7 +73,20 @@ def _monitor(args: argparse.Namespace) -> int:
     print(f"{about['run']}: {monitor.messages} messages, {monitor.steps} grid steps, "
           + ("no alarm" if first is None else
              f"first alarm at {first.t:.2f} s ({', '.join(first.alarms)})"))
+    if monitor.armed and not interrupted and Path(args.source).is_file():
+        _log_end(about["run"], monitor)
     return 0
+
+
+def _log_end(run: str, monitor) -> None:
+    """Whether a log that ended with the detector armed ended with the flight: the
+    autopilot's last HEARTBEAT says."""
+    if monitor.vehicle_armed:
+        print(f"{run}: the log stopped mid-flight at {monitor.last_t:.2f} s: the vehicle "
+              "was still armed")
+    elif monitor.vehicle_armed is None:
+        print(f"{run}: the log ends at {monitor.last_t:.2f} s; it holds no HEARTBEAT, so "
+              "whether the flight had ended is not known")
 
 
 def _replay(args: argparse.Namespace) -> int:
@@ -139,6 +154,12 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     try:
         return args.handler(args)
+    except ModuleNotFoundError as e:
+        if e.name != "pymavlink":
+            raise
+        print(f"alfa-bench {args.command}: pymavlink is not installed; it comes with the "
+              "live extra: pip install \"alfa-bench[live]\"", file=sys.stderr)
+        return 1
     except (KeyError, ValueError, OSError) as e:
         # a KeyError's str() is its repr: print the message
         message = e.args[0] if isinstance(e, KeyError) and e.args else e

@@ -32,16 +32,17 @@ from .base import (
     forks,
     labelled_segments,
     run_detector,
-    skipped_channels,
     source_digest,
     training_segments,
 )
 from .extremes import MaximaThresholds
+from .unmoved import UnmovedSensors, skipped_channels
 
 __all__ = ["BUILTIN", "BUILTIN_ENTRIES", "DEFAULT_RATE_HZ", "FAMILIES", "PLUGIN_GROUP", "REGISTRY",
            "CalibrationError", "Detector", "Fork", "Labelled", "MaximaThresholds",
-           "NotFittedError", "PairDetector", "StaleStateError", "Trace", "clone", "continue_forks",
-           "detector_module", "detector_name", "fault_free_segments", "fit_token", "fork_for",
+           "NotFittedError", "PairDetector", "StaleStateError", "Trace", "UnmovedSensors",
+           "clone", "continue_forks", "detector_module", "detector_name", "fault_free_segments",
+           "fit_token", "fork_for",
            "forks", "labelled_segments", "make_detector", "plugins", "run_detector",
            "skipped_channels", "source_digest", "training_segments"]
 

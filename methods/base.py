@@ -34,10 +34,11 @@ calibration column reads ``supervised``. Neither kind ever sees a flight of the 
 it scores (:func:`alfa_bench.analysis.held_out.check_held_out`).
 
 A signal that is not measured on a flight (constant over all of it, like measured
-airspeed from 2018-09-11 on) is never modelled: :func:`run_detector` skips the
-channels that score it, or every channel when a model input is dead
-(:func:`skipped_channels`), and :func:`fault_free_segments` leaves such flights out
-of calibration. Both are logged and recorded.
+airspeed from 2018-09-11 on) is never modelled: :func:`run_detector` does not score
+the channels that score it, or any channel when a model input is dead, until the
+sensor moves (causally, as the live monitor does: :mod:`.unmoved`), and
+:func:`fault_free_segments` leaves such flights out of calibration. Both are logged
+and recorded.
 
 The least a detector writes is its ``__init__`` (storing its hyper-parameters),
 :meth:`Detector.signals` and :meth:`Detector.update`: it then has one channel, named
@@ -64,12 +65,14 @@ import numpy as np
 
 from alfa_bench.data import AlfaDataError, Flight, Sampled, not_measured, parse_flight_name, sample
 
+from .unmoved import UnmovedSensors
+
 __all__ = ["DEFAULT_RATE_HZ", "FAMILIES", "CalibrationError", "Detector", "Fork", "Labelled",
            "NotFittedError", "PairDetector", "StaleStateError", "Trace", "clone",
            "continue_forks", "fault_free_segments", "fit_token", "fork_for", "forks",
            "free_part", "json_ready", "labelled_segments", "learned_state",
-           "leave_one_date_out", "run_detector", "segment_digest", "skipped_channels",
-           "source_digest", "training_segments"]
+           "leave_one_date_out", "run_detector", "segment_digest", "source_digest",
+           "training_segments"]
 
 log = logging.getLogger(__name__)
 
@@ -587,20 +590,6 @@ class Trace:
         return [(float(self.t[s]), float(self.t[e - 1])) for s, e in edges.reshape(-1, 2)]
 
 
-def skipped_channels(detector: Detector, dead) -> dict[str, str]:
-    """Channels of ``detector`` to skip when the signals ``dead`` are not measured: a
-    channel scoring a dead output, and every channel when a dead signal is an input
-    (no model is driven by a signal that is not there)."""
-    dead = [d for d in detector.signals() if d in set(dead)]
-    if not dead:
-        return {}
-    outputs = detector.channel_outputs()
-    inputs = [d for d in dead if d not in outputs]
-    return {ch: (f"input {inputs[0]} not measured" if inputs else f"{out} not measured")
-            for ch, out in zip(detector.channels(), outputs, strict=True)
-            if inputs or out in dead}
-
-
 @dataclass(frozen=True)
 class Fork:
     """A detector's run over the first steps of a flight, for the flights that share
@@ -712,7 +701,8 @@ def run_detector(detector: Detector, flight: Flight, probes: bool = False,
                  continued: tuple[Sampled, np.ndarray, dict] | None = None) -> Trace:
     """Run ``detector`` causally over ``flight``, from a fresh state; with ``probes``,
     keep :meth:`Detector.probes` of every step. Channels on signals the flight does not
-    measure are skipped (:func:`skipped_channels`).
+    measure are skipped: a channel is not scored while a sensor it reads has not moved
+    since the first step, as the live monitor does (:class:`~.unmoved.UnmovedSensors`).
 
     With ``fork``, a flight that begins with the fork's steps continues from its state
     instead: the same trace, without running those steps again. One that does not (or
@@ -728,10 +718,15 @@ def run_detector(detector: Detector, flight: Flight, probes: bool = False,
             score, kept = fork.continued(detector, s, probes)
         else:
             score, kept = detector.run(s, probes)
-    skipped = skipped_channels(detector, not_measured(flight, detector.signals()))
+    unmoved = UnmovedSensors(detector)
+    blanked = unmoved.blanked(s.x)
+    score[blanked] = np.nan
+    skipped = unmoved.skipped()
     if skipped:
-        score[:, [detector.channels().index(ch) for ch in skipped]] = np.nan
         log.info("%s: skipped %s", flight.id, skipped)
+    for ch in np.flatnonzero(blanked.any(axis=0) & ~blanked.all(axis=0)):
+        log.info("%s: %s not scored until %.2f s, a sensor it reads unmoved until then",
+                 flight.id, detector.channels()[ch], s.t[np.argmin(blanked[:, ch])])
     return Trace(t=s.t, score=score, alarm=detector.alarms(score), channels=detector.channels(),
                  threshold=threshold, probes=kept, skipped=skipped)
 

@@ -1,5 +1,7 @@
 """A sensor that is not measured on a flight (constant over all of it) is never modelled,
-never alarmed on and never injected into; a constant command is not missing data."""
+never alarmed on and never injected into; a constant command is not missing data. Its
+channels are not scored until it moves, a causal rule the batch run and the live monitor
+share."""
 
 from pathlib import Path
 
@@ -9,19 +11,25 @@ import pytest
 from alfa_bench.data import AlfaDataError, build_manifest, load_flight, not_measured
 from alfa_bench.data.inject import inject_grid, inject_sensor_fault
 from alfa_bench.data.synthetic import write_flight
+from alfa_bench.live import replay
+from alfa_bench.live.monitor import Monitor
 from alfa_bench.methods import fault_free_segments, make_detector, run_detector
 
 FREE = "carbonZ_2018-09-11-14-16-55_no_failure"
 BANK = {"inputs": ["roll_cmd", "pitch_cmd"], "outputs": ["roll", "airspeed"]}
 
 
-def kill(folder: Path, topic: str, column: str, value: str = "0.0") -> None:
-    """Set ``column`` of ``topic`` to ``value`` in every row, as ALFA's dead airspeed."""
+def kill(folder: Path, topic: str, column: str, value: str = "0.0",
+         rows_dead: int | None = None) -> None:
+    """Set ``column`` of ``topic`` to ``value`` in every row (or its first ``rows_dead``),
+    as ALFA's dead airspeed."""
     path = folder / f"{folder.name}-{topic}.csv"
     lines = path.read_text().splitlines()
     i = lines[0].split(",").index(column)
-    rows = [",".join(c if j != i else value for j, c in enumerate(line.split(",")))
-            for line in lines[1:]]
+    dead = len(lines) if rows_dead is None else rows_dead
+    rows = [",".join(c if j != i or r >= dead else value
+                     for j, c in enumerate(line.split(",")))
+            for r, line in enumerate(lines[1:])]
     path.write_text("\n".join([lines[0], *rows]) + "\n")
 
 
@@ -46,6 +54,39 @@ def test_its_channel_is_skipped_and_the_others_still_judge(dead_airspeed, corpus
     assert trace.skipped == {"airspeed": "airspeed not measured"}
     assert np.isnan(trace.score[:, 1]).all() and not trace.alarm[:, 1].any()
     assert np.isfinite(trace.score[:, 0]).any()
+
+
+def _monitor_scores(detector, flight) -> np.ndarray:
+    """The live monitor's scores on ``flight`` fed through the MAVLink map."""
+    decisions = []
+    monitor = Monitor(detector, on_decision=decisions.append)
+    for t, message, values in replay.messages(flight, detector.signals()):
+        monitor.feed(t, message, values)
+    return np.array([[d.scores[c] for c in detector.channels()] for d in decisions])
+
+
+@pytest.mark.parametrize("rows_dead", [None, 800])
+def test_a_sensor_unmoved_since_arming_is_not_scored_until_it_moves_live_as_in_batch(
+        rows_dead, tmp_path, corpus):
+    """Dead all flight, or for its first half: the batch run cannot know which while it
+    is unmoved, and the monitor, fed the same flight, leaves the same steps unscored."""
+    folder = write_flight(tmp_path / "processed", FREE, seed=7)
+    kill(folder, "mavros-nav_info-airspeed", "field.measured", "0.0", rows_dead)
+    detector = make_detector("kalman_okid", BANK)
+    detector.fit(fault_free_segments(detector, [load_flight(p) for p in corpus.iterdir()], 1.0))
+    flight = load_flight(folder)
+    trace = run_detector(detector, flight)
+    blank = np.isnan(trace.score[:, 1])
+    assert blank[0] and np.isfinite(trace.score[:, 0]).any()
+    if rows_dead is None:
+        assert blank.all() and trace.skipped == {"airspeed": "airspeed not measured"}
+    else:       # moving from about 40 s: scored from then on
+        moved = trace.t >= flight.topic("mavros-nav_info-airspeed").t[rows_dead]
+        assert blank.tolist() == (~moved).tolist() and not trace.skipped
+    live = _monitor_scores(detector, flight)
+    n = min(len(live), len(trace.t))
+    assert n >= len(trace.t) - 1
+    np.testing.assert_array_equal(np.isnan(live[:n]), np.isnan(trace.score[:n]))
 
 
 def test_a_dead_input_skips_every_channel(dead_airspeed, corpus):

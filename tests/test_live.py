@@ -2,18 +2,23 @@
 UDP on localhost, gives the monitor the workflow's first alarm within one grid step; a
 model reading the fault emulation's signals is refused for a link unless allowed."""
 
+import math
 import os
 import socket
+import sys
 import threading
+from pathlib import Path
 
 import numpy as np
 import pytest
+from unavailable import unavailable
+from workflow_runs import REPO
 
 import alfa_bench as ab
 from alfa_bench.data import hold, parse_flight_name, sample
 from alfa_bench.live import mavlink, replay
 from alfa_bench.live.monitor import Monitor, watch
-from alfa_bench.methods import make_detector
+from alfa_bench.methods import fault_free_segments, make_detector, run_detector
 
 RUNS = ["residual_logistic_published_date", "coincidence", "residual_bank"]
 
@@ -30,9 +35,7 @@ def local(corpus, tmp_path_factory):
 
 
 def _batch_first_alarm(detector, flight) -> float | None:
-    s = sample(flight, detector.signals(), detector.rate_hz)
-    alarm = detector.alarms(detector.run(s)[0]).any(axis=1)
-    return float(s.t[np.argmax(alarm)]) if alarm.any() else None
+    return run_detector(detector, flight).first_alarm_s()
 
 
 def _same(live: float | None, batch: float | None, rate_hz: float) -> bool:
@@ -86,24 +89,37 @@ def test_the_workflows_record_is_the_batch_run_the_monitor_matches(local):
 
 
 def test_the_hold_is_the_data_layers(local):
-    """The monitor's grid values and freshness are sample()'s, to float32 rounding, on a
-    flight replayed through the map."""
-    det = ab.fit_run("residual_bank", local)
-    flight = local.flight(next(iter(local.flights)))
+    """The monitor's grid values and freshness are sample()'s, on a flight replayed as
+    real MAVLink packets: to float32 rounding, and an int16 field to its unit (cm/s for
+    GLOBAL_POSITION_INT's velocities, a degree for nav_bearing), as a link rounds them."""
+    from pymavlink.dialects.v20 import ardupilotmega
+
+    det = make_detector("kalman_okid", {"inputs": ["roll_cmd", "yaw_cmd"],
+                                        "outputs": ["roll", "nav_vel_north", "nav_vel_down"]})
+    flights = [local.flight(n) for n in local.flights]
+    det.fit(fault_free_segments(det, flights, 1.0))
+    flight = flights[0]
     s = sample(flight, det.signals(), det.rate_hz)
     fed = []
     monitor = Monitor(det)
     update = monitor.detector.update
     monitor.detector.update = lambda x, f: fed.append((x.copy(), f.copy())) or update(x, f)
-    for t, message, values in replay.messages(flight, det.signals()):
-        fields = mavlink.encode(message, values)
-        back = mavlink.decode(message, lambda n, fs=fields: float(np.float32(fs.get(n, 0))))
-        monitor.feed(t, message, back)
+    parser = ardupilotmega.MAVLink(None)
+    for t, packet in replay.packets(flight, det.signals()):
+        msg = parser.decode(bytearray(packet))
+        if msg.get_type() in mavlink.MESSAGES:
+            monitor.feed(t, msg.get_type(),
+                         mavlink.decode(msg.get_type(), lambda n, m=msg: getattr(m, n)))
     x = np.array([a for a, _ in fed])[:s.t.size]
     fresh = np.array([b for _, b in fed])[:s.t.size]
     assert x.shape == s.x.shape
-    np.testing.assert_allclose(x, s.x, rtol=1e-6, atol=1e-5)
-    np.testing.assert_array_equal(fresh, s.fresh)
+    quantum = {"nav_vel_north": 0.01, "nav_vel_east": 0.01, "nav_vel_down": 0.01,
+               "yaw_cmd": 1.0, "yaw_error": 1.0}
+    for j, name in enumerate(s.names):
+        atol = quantum.get(name, 0.0) / 2 + 1e-5
+        np.testing.assert_allclose(x[:, j], s.x[:, j], rtol=1e-6, atol=atol, err_msg=name)
+        if name not in quantum:     # a rounded value may repeat where the flight's moved
+            np.testing.assert_array_equal(fresh[:, j], s.fresh[:, j], err_msg=name)
 
 
 def test_the_grid_starts_at_a_step_that_holds_a_record():
@@ -297,3 +313,71 @@ def test_the_command_names_a_missing_log_and_a_monitor_that_never_armed(
     assert cli.main(["monitor", str(model), str(tmp_path / "imu.tlog")]) == 1
     err = capsys.readouterr().err
     assert "never armed: no message gave" in err and "roll" in err
+
+
+def _heartbeat(t: float, armed: bool) -> bytes:
+    from pymavlink.dialects.v20 import ardupilotmega as mav
+
+    m = mav.MAVLink(None, srcSystem=1, srcComponent=1)
+    mode = mav.MAV_MODE_FLAG_SAFETY_ARMED if armed else 0
+    return m.heartbeat_encode(mav.MAV_TYPE_FIXED_WING, mav.MAV_AUTOPILOT_ARDUPILOTMEGA,
+                              mode, 0, mav.MAV_STATE_ACTIVE).pack(m)
+
+
+def test_a_log_cut_mid_flight_ends_with_a_line_saying_so(local, quiet_flight, tmp_path,
+                                                          capsys):
+    """The autopilot's HEARTBEAT says armed to the last one: the log stopped mid-flight,
+    at its last message's time; one ending disarmed ends with the summary."""
+    import struct
+
+    from alfa_bench import cli
+    from alfa_bench.methods.model_files import save_model
+
+    _, flight = quiet_flight
+    det = ab.fit_run("residual_logistic_published_date", local)
+    model = save_model(det, tmp_path / "m.abm", run="residual_logistic_published_date")
+    epoch = replay.flight_epoch_s(flight)
+    packets = list(replay.packets(flight, det.signals()))
+    cut = packets[: len(packets) // 2]
+    beats = [(t, _heartbeat(t, True)) for t in np.arange(cut[0][0], cut[-1][0], 1.0)]
+    logs = {"cut": sorted(cut + beats, key=lambda p: p[0]),
+            "disarmed": sorted(cut + beats, key=lambda p: p[0])
+            + [(cut[-1][0], _heartbeat(cut[-1][0], False))]}
+    for name, out in logs.items():
+        with open(tmp_path / f"{name}.tlog", "wb") as f:
+            for t, p in out:
+                f.write(struct.pack(">Q", round((epoch + t) * 1e6)) + p)
+    assert cli.main(["monitor", str(model), str(tmp_path / "cut.tlog")]) == 0
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert last == ("residual_logistic_published_date: the log stopped mid-flight at "
+                    f"{cut[-1][0] + epoch - math.floor(epoch + cut[0][0]):.2f} s: the "
+                    "vehicle was still armed")
+    assert cli.main(["monitor", str(model), str(tmp_path / "disarmed.tlog")]) == 0
+    assert "grid steps" in capsys.readouterr().out.strip().splitlines()[-1]
+
+
+def test_a_ulog_or_a_dataflash_log_is_refused_by_name(local, tmp_path, capsys):
+    """Real logs of other formats (the folder of tests/README's flight logs, or
+    ALFA_LOGS): each named as a format the monitor does not read, no crash."""
+    from alfa_bench import cli
+    from alfa_bench.methods.model_files import save_model
+
+    logs = Path(os.environ.get("ALFA_LOGS", REPO.parent / "shared" / "logs"))
+    if not (logs / "ardupilot" / "test.BIN").is_file():
+        unavailable(f"the flight logs of other formats are not at {logs}: set ALFA_LOGS")
+    model = save_model(ab.fit_run("coincidence", local), tmp_path / "m.abm", run="coincidence")
+    for path, named in [(logs / "px4" / "sample.ulg", "a PX4 ULog, not read"),
+                        (logs / "ardupilot" / "test.BIN",
+                         "an ArduPilot DataFlash log, not read")]:
+        assert cli.main(["monitor", str(model), str(path)]) == 1
+        assert f"{path}: {named}" in capsys.readouterr().err
+
+
+def test_without_pymavlink_the_command_names_the_extra(local, tmp_path, monkeypatch, capsys):
+    from alfa_bench import cli
+    from alfa_bench.methods.model_files import save_model
+
+    model = save_model(ab.fit_run("coincidence", local), tmp_path / "m.abm", run="coincidence")
+    monkeypatch.setitem(sys.modules, "pymavlink", None)
+    assert cli.main(["monitor", str(model), "udpin:127.0.0.1:14550"]) == 1
+    assert 'pip install "alfa-bench[live]"' in capsys.readouterr().err

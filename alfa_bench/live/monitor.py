@@ -8,7 +8,9 @@ the record before the previous step's. The grid is :math:`k / f` on the source's
 (``f`` the detector's rate) from the first step at which every signal has a record; a
 step is decided once a message later than it arrives (no record for it can come after).
 Each step feeds :meth:`~alfa_bench.methods.Detector.update`; a channel whose score
-exceeds its threshold is an alarm (:class:`Decision`).
+exceeds its threshold is an alarm (:class:`Decision`). A channel reading a sensor that
+has not moved since arming is not scored (NaN) until it does, by the batch run's rule
+(:class:`~alfa_bench.methods.UnmovedSensors`).
 
 The clock (:func:`message_time`) is a log's timestamp (``clock="log"``, a ``.tlog``) or
 the messages' own time fields (``clock="link"``): ``time_usec``, ``time_boot_ms``, a
@@ -30,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from alfa_bench.data import MAX_HOLD_S, SIGNALS, first_grid_step, hold
-from alfa_bench.methods import Detector
+from alfa_bench.methods import Detector, UnmovedSensors
 
 from . import mavlink
 
@@ -144,6 +146,7 @@ class Monitor:
                              "emulation, not measured: refused for a live link unless "
                              "allowed explicitly")
         self.detector = detector.reset()
+        self.unmoved = UnmovedSensors(detector)
         self.names = tuple(names)
         self.measured = mavlink.fields_for(names)
         self.records = {n: _Records() for n in self.measured}
@@ -164,6 +167,8 @@ class Monitor:
         self.first_alarm: Decision | None = None
         self.alarming: set[str] = set()
         self.origin_s: float | None = None
+        #: the vehicle armed by its last HEARTBEAT (None: no HEARTBEAT read)
+        self.vehicle_armed: bool | None = None
 
     def missing(self) -> list[str]:
         """The measured signals no message has given yet."""
@@ -246,6 +251,7 @@ class Monitor:
         why = why or f"stale: {', '.join(stale)} held over {self.stale_s:g} s"
         self._set_state(f"{why}; re-arming", t_step)
         self.detector.reset()
+        self.unmoved = UnmovedSensors(self.detector)
         self.records = {n: _Records() for n in self.measured}
         self.prev_source = {n: -1 for n in self.measured}
         self.next_step = None
@@ -265,7 +271,12 @@ class Monitor:
                       if n in mavlink.DIFFERENCES else held[n] for n in self.names])
         f = np.array([fresh[mavlink.DIFFERENCES[n][0]] if n in mavlink.DIFFERENCES
                       else fresh[n] for n in self.names])
-        score = np.asarray(self.detector.update(x, f), dtype=float)
+        score = np.array(self.detector.update(x, f), dtype=float)
+        was = self.unmoved.unmoved()
+        score[self.unmoved.blanked(x[None, :])[0]] = np.nan
+        if self.unmoved.unmoved() != was:
+            log.info("not scored while unmoved since arming: %s at t=%.2f s",
+                        ", ".join(self.unmoved.unmoved()) or "none", t_step)
         alarm = self.detector.alarms(score[None, :])[0]
         decision = Decision(t_step, dict(zip(self.channels, map(float, score), strict=True)),
                             self.thresholds,
@@ -282,6 +293,11 @@ class Monitor:
         return decision
 
 
+def _magic(path: str) -> bytes:
+    with open(path, "rb") as f:
+        return f.read(4)
+
+
 def watch(source: str, monitor: Monitor, clock: str | None = None,
           stop=lambda: False) -> Monitor:
     """Feed ``monitor`` from ``source`` in pymavlink's connection syntax (a ``.tlog``
@@ -289,19 +305,31 @@ def watch(source: str, monitor: Monitor, clock: str | None = None,
     ends or ``stop()`` is true: the message types its signals need, from the system that
     sent the first of them. ``clock`` defaults to ``"log"`` for a file, else
     ``"link"``; a log's times are counted from the whole second before its first
-    message (``monitor.origin_s``), so that its grid is the flight's."""
-    from pymavlink import mavutil
+    message (``monitor.origin_s``), so that its grid is the flight's. The autopilot's
+    ``HEARTBEAT`` says whether the vehicle is armed (``monitor.vehicle_armed``).
+
+    A PX4 ULog or an ArduPilot DataFlash log (``.bin``) is refused (ValueError): their
+    messages are not MAVLink's."""
+    from pymavlink import DFReader, mavutil
 
     is_file = Path(source).is_file()
     if not is_file and ":" not in source and not Path(source).exists():
         raise FileNotFoundError(f"{source}: no such log, device or link")
+    if is_file and _magic(source) == b"ULog":
+        raise ValueError(f"{source}: a PX4 ULog, not read: the monitor reads MAVLink, a "
+                         "telemetry log (.tlog) or a link")
     clock = clock or ("log" if is_file else "link")
     conn = mavutil.mavlink_connection(source, robust_parsing=True, dialect="ardupilotmega")
+    if isinstance(conn, DFReader.DFReader):
+        conn.close()
+        raise ValueError(f"{source}: an ArduPilot DataFlash log, not read: its messages "
+                         "are not MAVLink's; the monitor reads a telemetry log (.tlog) "
+                         "or a link")
     sock = getattr(conn, "port", None)
     if isinstance(sock, socket.socket) and sock.type == socket.SOCK_DGRAM:
         # a burst outruns a slow step: the kernel holds it rather than drop it
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 8 << 20)
-    wanted = [*mavlink.messages_for(monitor.names), "SYSTEM_TIME"]
+    wanted = [*mavlink.messages_for(monitor.names), "SYSTEM_TIME", "HEARTBEAT"]
     state: dict = {}
     monitor.origin_s = None
     system = None
@@ -312,17 +340,24 @@ def watch(source: str, monitor: Monitor, clock: str | None = None,
                 if is_file:
                     break
                 continue
+            kind = msg.get_type()
+            # a ground station's or companion's heartbeat names no autopilot
+            if kind == "HEARTBEAT" and msg.autopilot == mavutil.mavlink.MAV_AUTOPILOT_INVALID:
+                continue
             # the autopilot's messages only: a ground station's SYSTEM_TIME is another clock
             system = msg.get_srcSystem() if system is None else system
             if msg.get_srcSystem() != system:
                 monitor.dropped["another system"] += 1
+                continue
+            if kind == "HEARTBEAT":
+                monitor.vehicle_armed = bool(
+                    msg.base_mode & mavutil.mavlink.MAV_MODE_FLAG_SAFETY_ARMED)
                 continue
             t = message_time(msg, clock, state)
             if not math.isfinite(t):
                 continue
             if monitor.origin_s is None:
                 monitor.origin_s = float(math.floor(t)) if clock == "log" else 0.0
-            kind = msg.get_type()
             monitor.feed(t - monitor.origin_s, kind,
                          mavlink.decode(kind, lambda name, m=msg: getattr(m, name)))
     finally:
