@@ -71,6 +71,9 @@ def test_blocks_follow_the_role_and_the_inputs():
     assert block({"role": "reference", "reads_actuators": True}) == "reference"
     assert block({"role": "method", "reads_actuators": True}) == "reads actuators"
     assert block({"role": "method", "reads_actuators": False}) == "honest"
+    # what the detector declares: one that sees the whole flight is a reference row
+    assert block({"role": "method", "reads_actuators": False, "causal": False}) == "reference"
+    assert block({"role": "method", "reads_actuators": False, "causal": True}) == "honest"
 
 
 def test_only_a_calibration_by_date_is_ranked_honest():
