@@ -289,7 +289,7 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
     # the scored rows' columns in their order, also where a subset's first row is unscored
     columns = dict.fromkeys(k for r in sorted(rows, key=lambda r: not r["flights"]) for k in r)
     table = pd.DataFrame(rows).reindex(columns=list(columns))
-    if table["flights"].all():
+    if table.empty or table["flights"].all():
         return table
     # the counts stay whole numbers beside the empty cells of a run not scored
     counts = pd.DataFrame([r for r in rows if r["flights"]]).select_dtypes("integer")
