@@ -343,8 +343,11 @@ def compare(*results: Result, published: str | os.PathLike | None = None) -> pd.
     run's settings (:data:`SCORING_SETTINGS`: deadline, subsets, grouping, margin,
     pools and stable share), on its corpus (the same flights, the same files), by the
     same alfa-bench version; otherwise a :class:`ValueError` names the setting that
-    differs. Every run is ranked on the flights every run scored; one that failed on
-    flights the others scored is flagged (``failed_flights``).
+    differs. Every run is scored on the flights every ranked (honest) run scored
+    (:func:`~alfa_bench.outputs.tables.common_ground`); one that failed on flights the
+    others scored is flagged (``failed_flights``). A run not causal, reading actuators or
+    calibrated by anything but the date is not ranked, as in the workflow's tables
+    (:func:`~alfa_bench.analysis.blocks.block`).
 
     Raises
     ------

@@ -351,6 +351,8 @@ def detection_record(method: str, spec: dict, detector: Detector, flight: Flight
         # a detector of a script or notebook: which code scored (methods.source_digest)
         **({"detector_source": spec["source"]} if "source" in spec else {}),
         "role": spec.get("role", "method"),
+        # what the detector declares: one that is not causal is a reference row (blocks)
+        "causal": bool(detector.causal),
         "family": detector.family,
         # whether it reads what the fault emulation writes: from its signals, never set
         "reads_actuators": reads_actuators(detector.signals()),

@@ -12,9 +12,10 @@ labels to choose; the logistic regression is supervised. Read down a column
 for the learner, across a row for the features.
 
 Every cell counts what :func:`~.per_flight.subset_counts` counts on the headline
-subset with the deadline, and says whether the run beats ``silent`` there (the
-comparison's ``beats_silence``); a fair-best cell also names the configurations tried
-and the one chosen per scored date.
+subset's common ground (the flights every ranked run scored, as the comparison ranks
+them: :func:`~alfa_bench.outputs.tables.common_ground`) with the deadline, and says
+whether the run beats ``silent`` there (the comparison's ``beats_silence``); a
+fair-best cell also names the configurations tried and the one chosen per scored date.
 """
 
 from __future__ import annotations
@@ -78,13 +79,16 @@ def chosen_configurations(records: list[dict]) -> str:
 
 def features_learners(per_flight: pd.DataFrame, comparison: pd.DataFrame,
                       manifest: pd.DataFrame, rows: list[dict], primary: str,
-                      stable: float, chosen: dict[str, str]) -> pd.DataFrame:
+                      stable: float, chosen: dict[str, str],
+                      left_out: pd.DataFrame) -> pd.DataFrame:
     """One row per learner and feature column of the config's ``rows`` whose run was
     scored: the run, whether it is supervised, the configurations it tried and those
     it chose (``chosen``, by run), its :func:`~.per_flight.subset_counts` on
-    ``primary`` and whether it beats ``silent`` there."""
-    members = set(subset_flights(manifest, primary))
-    on_primary = comparison[comparison["subset"] == primary].set_index("method")
+    ``primary``'s flights on the common ground (those of ``left_out``, as
+    ``left_out.csv``, are not) and whether it beats ``silent`` there."""
+    members = set(subset_flights(manifest, primary)) - set(left_out["flight"])
+    on_primary = comparison[(comparison["subset"] == primary)
+                            & (comparison["flights"] > 0)].set_index("method")
     out = []
     for row in rows:
         for key, header in FEATURE_COLUMNS.items():

@@ -21,12 +21,16 @@ subset: fault class, flights, flight time, detections, mean and max detection ti
 accuracy, and a total row.
 
 Every table compares like with like: runs are scored on the *common ground*, the
-labelled flights every run scored (:func:`common_ground`). A flight refused at load
-(for every run), or one that some run failed on (a fold it could not calibrate), is
-left out for all of them; ``results/tables/left_out.csv`` lists those flights with
-the runs that failed and why, the ``excluded`` column of the summary and comparison
-counts them per subset, and ``failed_flights`` counts a run's own failures, which
-flag it. ``results/tables/failures.csv`` (:func:`failures_table`) holds every error.
+labelled flights every ranked (honest) run scored (:func:`common_ground`). A flight
+refused at load (for every run), or one that a ranked run failed on (a fold it could
+not calibrate), is left out for all of them; ``results/tables/left_out.csv`` lists
+those flights with every run that failed on them and each one's error, the
+``excluded`` column of the summary and comparison counts them per subset, and
+``failed_flights`` counts a run's own failures, which flag it. A reference or
+actuator-reading run that failed on a flight leaves it on the common ground: its row
+is scored on the flights of it that it scored (``flights``). A run that scored no
+flight of a subset has a row all the same, with ``flights`` 0 and no scores.
+``results/tables/failures.csv`` (:func:`failures_table`) holds every error.
 """
 
 from __future__ import annotations
@@ -67,7 +71,7 @@ def failures_table(load: pd.DataFrame, per_method: list[pd.DataFrame]) -> pd.Dat
 
 #: the columns of ``left_out.csv``: a flight off the common ground, the subsets it is
 #: in, the stages it failed at, the runs that failed on it ("every run" at load) and
-#: the first error
+#: each one's error (``run: error``, joined by " | ")
 LEFT_OUT_COLUMNS = ["flight", "subsets", "stage", "runs", "error"]
 
 
@@ -81,17 +85,23 @@ def _failures(failures: pd.DataFrame | None) -> pd.DataFrame:
 
 def common_ground(records: list[dict], manifest: pd.DataFrame,
                   failures: pd.DataFrame | None = None) -> tuple[list[dict], pd.DataFrame]:
-    """The records of the flights every run scored, and the flights left out of that
-    common ground (:data:`LEFT_OUT_COLUMNS`): those refused at load, then those some run
-    failed on, each with the runs that did and the first error.
+    """The records of the flights every ranked run (block ``honest``:
+    :func:`~alfa_bench.analysis.blocks.block`) scored, and the flights left out of that
+    common ground (:data:`LEFT_OUT_COLUMNS`): those refused at load, then those a
+    ranked run failed on, each with every run that failed on it and each one's error.
 
-    A run that scored no flight at all does not shrink the common ground (it has no row;
-    :func:`unscored_notes` names it). Every labelled flight a run has no record of must
-    be one of its ``failures``: else :class:`ValueError`."""
+    Only the ranked runs decide it: a reference or actuator-reading run that failed on
+    a flight leaves it on the common ground, and keeps its records of the rest. A run
+    that scored no flight at all does not shrink it either (its comparison row says it
+    scored none; :func:`unscored_notes` names it). Every labelled flight a run has no
+    record of must be one of its ``failures``: else :class:`ValueError`."""
     f = _failures(failures)
     by_method: dict[str, set[str]] = {}
+    blocks: dict[str, str] = {}
     for r in records:
         by_method.setdefault(r["method"], set()).add(r["flight"])
+        # as every table blocks a run: by its first record
+        blocks.setdefault(r["method"], block(r))
     labelled = manifest.loc[manifest["ground_truth"], "flight"].tolist()
     own = {m: set(g["flight"]) for m, g in f[f["method"] != ""].groupby("method")}
     for method, scored in by_method.items():
@@ -99,28 +109,33 @@ def common_ground(records: list[dict], manifest: pd.DataFrame,
         if missing:
             raise ValueError(f"method {method}: no detection for {len(missing)} flight(s), "
                              f"e.g. {missing[0]}, and no failure reported")
-    common = set(labelled).intersection(*by_method.values())
+    common = set(labelled).intersection(
+        *(scored for method, scored in by_method.items() if blocks[method] == "honest"))
     rows = [{"flight": r["flight"], "subsets": r["subsets"], "stage": "load",
              "runs": "every run", "error": r["error"]}
             for r in f[f["stage"] == "load"].to_dict(orient="records")]
     subsets = manifest.set_index("flight")["subsets"]
     for flight in (x for x in labelled if x not in common):
-        mine = f[(f["flight"] == flight) & (f["method"] != "")]
+        mine = f[(f["flight"] == flight) & (f["method"] != "")].sort_values(
+            "method", kind="stable")
         rows.append({"flight": flight, "subsets": subsets[flight],
                      "stage": ";".join(dict.fromkeys(mine["stage"])),
-                     "runs": ";".join(sorted(set(mine["method"]))),
-                     "error": mine["error"].iloc[0] if len(mine) else ""})
+                     "runs": ";".join(dict.fromkeys(mine["method"])),
+                     "error": " | ".join(dict.fromkeys(
+                         f"{m}: {e}" for m, e in zip(mine["method"], mine["error"],
+                                                     strict=True)))})
     return ([r for r in records if r["flight"] in common],
             pd.DataFrame(rows, columns=LEFT_OUT_COLUMNS))
 
 
-def _on_ground(kept: list[dict], manifest: pd.DataFrame, subsets,
+def _on_ground(records: list[dict], manifest: pd.DataFrame, subsets,
                failures: pd.DataFrame | None) -> dict[str, dict[str, tuple[list[dict], int, int]]]:
-    """subset -> method -> (its records ``kept`` on the common ground
-    (:func:`common_ground`) of the subset's flights, the flights of the subset it failed
-    on itself, the subset's flights off the common ground: refused at load or not
-    scored by every run, ``excluded`` from every run alike). A subset with no flight
-    scored has no row."""
+    """subset -> method -> (its records on the common ground (:func:`common_ground`) of
+    the subset's flights, the flights of the subset it failed on itself, the subset's
+    flights off the common ground: refused at load or failed by a ranked run,
+    ``excluded`` from every run alike). A run with no record on the subset's common
+    ground has no entry; a subset with no flight scored has none."""
+    kept, left_out = common_ground(records, manifest, failures)
     f = _failures(failures)
     own = f[f["method"] != ""]
     by_method: dict[str, dict[str, dict]] = {}
@@ -130,13 +145,12 @@ def _on_ground(kept: list[dict], manifest: pd.DataFrame, subsets,
     for subset in subsets:
         flights = subset_flights(manifest, subset)
         failed = own[own["flight"].isin(flights)].groupby("method")["flight"].nunique()
-        refused = len(in_subset(f[f["stage"] == "load"], subset))
+        excluded = len(in_subset(left_out, subset))
         out[subset] = {}
         for method, recs in by_method.items():
             scored = [recs[x] for x in flights if x in recs]
             if scored:
-                out[subset][method] = (scored, int(failed.get(method, 0)),
-                                       len(flights) - len(scored) + refused)
+                out[subset][method] = (scored, int(failed.get(method, 0)), excluded)
     return out
 
 
@@ -151,8 +165,7 @@ def _scores(recs: list[dict], deadline_s: float) -> tuple[list[str], dict]:
 def summary_table(records: list[dict], manifest: pd.DataFrame, subsets, deadline_s: float,
                   failures: pd.DataFrame | None = None) -> pd.DataFrame:
     rows = []
-    kept, _ = common_ground(records, manifest, failures)
-    for subset, runs in _on_ground(kept, manifest, subsets, failures).items():
+    for subset, runs in _on_ground(records, manifest, subsets, failures).items():
         for method, (recs, failed, excluded) in runs.items():
             _, s = _scores(recs, deadline_s)
             rows.append({"method": method, "subset": subset, "block": block(recs[0]),
@@ -199,16 +212,20 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
     Ranks compare like with like: every run is scored on the common ground
     (:func:`common_ground`), and a run that failed on flights the others scored is
     ranked there all the same, flagged by ``failed_flights``. An honest run that never
-    armed is not ranked: ``not_ranked`` says so and it follows the ranked ones.
+    armed is not ranked: ``not_ranked`` says so and it follows the ranked ones. A run
+    that failed on every flight of a subset it has flights of comes last, with
+    ``flights`` 0, ``not_ranked`` "not scored" and no block or scores.
 
     Under resampled calibration pools (:mod:`alfa_bench.analysis.stability`): the
     stable detections (survival at least ``stable``), the central ``interval`` of the
     in-time detections over the pools, and ``rank_range``, the ranks a ranked run
     takes over the pools (the other ranked runs re-scored under the same pools)."""
-    kept, _ = common_ground(records, manifest, failures)
-    ground = _on_ground(kept, manifest, subsets, failures)
+    kept, left_out = common_ground(records, manifest, failures)
+    ground = _on_ground(records, manifest, subsets, failures)
     pooled = stability_table(kept, manifest, subsets, deadline_s, stable, interval
                              ).set_index(["subset", "method"])
+    own = _failures(failures)
+    own = own[own["method"] != ""]
     rows = []
     for subset in subsets:
         runs = []
@@ -261,7 +278,22 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
             row["vs_best_only_this"], row["vs_best_only_best"] = test["only_a"], test["only_b"]
             row["vs_best_p"] = test["p_value"]
             rows.append(row)
-    return pd.DataFrame(rows)
+        failed = own[own["flight"].isin(subset_flights(manifest, subset))]
+        for method, mine in failed.groupby("method", sort=False):
+            if method not in ground[subset]:
+                rows.append({"subset": subset, "method": method, "block": "",
+                             "deadline_s": deadline_s, "flights": 0,
+                             "excluded": len(in_subset(left_out, subset)),
+                             "failed_flights": mine["flight"].nunique(),
+                             "not_ranked": "not scored"})
+    # the scored rows' columns in their order, also where a subset's first row is unscored
+    columns = dict.fromkeys(k for r in sorted(rows, key=lambda r: not r["flights"]) for k in r)
+    table = pd.DataFrame(rows).reindex(columns=list(columns))
+    if table.empty or table["flights"].all():
+        return table
+    # the counts stay whole numbers beside the empty cells of a run not scored
+    counts = pd.DataFrame([r for r in rows if r["flights"]]).select_dtypes("integer")
+    return table.astype(dict.fromkeys(counts.columns, "Int64"))
 
 
 def _rank_ranges(ranked: list[dict], recs_of: dict[str, list[dict]], deadline_s: float) -> None:
@@ -301,8 +333,7 @@ def by_fault_table(records: list[dict], manifest: pd.DataFrame, subsets, deadlin
                    failures: pd.DataFrame | None = None) -> pd.DataFrame:
     info = manifest.set_index("flight")
     rows = []
-    kept, _ = common_ground(records, manifest, failures)
-    for subset, runs in _on_ground(kept, manifest, subsets, failures).items():
+    for subset, runs in _on_ground(records, manifest, subsets, failures).items():
         for method, (recs, _, _) in runs.items():
             groups = {c: [r for r in recs if r["fault_class"] == c] for c in FAULT_ORDER}
             groups["total"] = recs
@@ -436,10 +467,16 @@ def _stable(r) -> str:
             f"[{fmt(r['detections_low'], digits=0)}, {fmt(r['detections_high'], digits=0)}]")
 
 
+def _scored(comparison: pd.DataFrame) -> pd.DataFrame:
+    """The rows of runs that scored a flight: the others are listed apart
+    (:func:`unscored_notes`)."""
+    return comparison[comparison["flights"] > 0] if len(comparison) else comparison
+
+
 def _comparison_sections(comparison: pd.DataFrame, primary: str | None = None
                          ) -> list[Section]:
     out = []
-    for subset, table in comparison.groupby("subset", sort=False):
+    for subset, table in _scored(comparison).groupby("subset", sort=False):
         d = _deadline(table)
         header = ["rank", "method", "detector", "calibration", f"precision % ≤{d} s [95 % CI]",
                   f"recall % ≤{d} s [95 % CI]", f"accuracy % ≤{d} s [95 % CI]",
@@ -460,12 +497,16 @@ def _comparison_sections(comparison: pd.DataFrame, primary: str | None = None
             rank = r.get("rank")
             why = r.get("not_ranked")
             failed = int(r.get("failed_flights") or 0)
+            # a ranked run's failure took the flight off the common ground; another's not
+            flag = "" if not failed else (
+                f" (FLAGGED: failed on {failed} flight{'s' * (failed > 1)}; "
+                + ("ranked on the common ground)" if r.get("block") == "honest" else
+                   f"scored on {int(r['flights'])} flights of the common ground)"))
             return [why if isinstance(why, str) and why else
                     "-" if fmt(rank) == "-" else str(int(rank)),
                     r["method"] + (" (no better than silence)"
                                    if r.get("beats_silence") is False else "")
-                    + (f" (FLAGGED: failed on {failed} flight{'s' * (failed > 1)}; "
-                       "ranked on the common ground)" if failed else ""),
+                    + flag,
                     r["detector"], r["calibration"],
                     _rate(r, "precision"), _rate(r, "recall"), _rate(r, "accuracy"),
                     _stable(r), r["rank_range"] if isinstance(r.get("rank_range"), str) else "-",
@@ -495,9 +536,11 @@ def _comparison_sections(comparison: pd.DataFrame, primary: str | None = None
 
 def ground_note(table: pd.DataFrame) -> str:
     """A subset's size and its common ground, from its rows of the comparison or
-    summary: ``26 flights`` or ``26 flights, 22 on the common ground, 4 left out``."""
-    first = table.iloc[0]
-    scored, left = int(first["flights"]), int(first.get("excluded", 0))
+    summary: ``26 flights`` or ``26 flights, 22 on the common ground, 4 left out``.
+    The common ground is the most flights a row scored: every ranked run's, and every
+    run's that failed on none of it."""
+    scored = int(table["flights"].max())
+    left = int(table["excluded"].iloc[0]) if "excluded" in table else 0
     return (f"{scored + left} flights" if not left else
             f"{scored + left} flights, {scored} on the common ground, {left} left out")
 
@@ -527,7 +570,7 @@ def comparison_notes(comparison: pd.DataFrame) -> str:
     """Per subset, one line: which runs the data cannot tell apart from the best honest
     method (exact McNemar, p >= 0.05)."""
     lines = []
-    for subset, table in comparison.groupby("subset", sort=False):
+    for subset, table in _scored(comparison).groupby("subset", sort=False):
         best = table.loc[table["rank"] == 1, "method"] if "rank" in table else []
         if not len(best):
             lines.append(f"- `{subset}`: no honest method.")
@@ -569,7 +612,8 @@ def unscored_notes(comparison: pd.DataFrame, failures: pd.DataFrame, manifest: p
     own = failures[failures["method"].fillna("") != ""] if len(failures) else failures
     for subset in subsets:
         flights = set(subset_flights(manifest, subset))
-        scored = set(comparison.loc[comparison["subset"] == subset, "method"]) \
+        scored = set(comparison.loc[(comparison["subset"] == subset)
+                                    & (comparison["flights"] > 0), "method"]) \
             if len(comparison) else set()
         for method, rows in own.groupby("method", sort=False) if len(own) else []:
             rows = rows[rows["flight"].isin(flights)]

@@ -144,6 +144,8 @@ rule features_learners:
         manifest="results/flights.csv",
         per_flight="results/tables/per_flight.csv",
         comparison="results/tables/comparison.csv",
+        # the flights off the common ground, which no cell counts
+        left_out="results/tables/left_out.csv",
         # the nested runs' records, for the configuration each scored date chose
         nested=[f"results/detections/{row[key]}"
                 for row in config.get("features_learners", [])

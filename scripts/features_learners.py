@@ -22,7 +22,7 @@ chosen = {Path(folder).name: chosen_configurations(read_records([folder]))
           for folder in sm.input.nested}
 table = features_learners(read_table(sm.input.per_flight), read_table(sm.input.comparison),
                           manifest, list(sm.params.rows), sm.params.primary,
-                          float(sm.params.stable), chosen)
+                          float(sm.params.stable), chosen, read_table(sm.input.left_out))
 table.to_csv(sm.output.csv, index=False)
 Path(sm.output.md).write_text(features_learners_markdown(table, sm.params.primary,
                                                          float(sm.params.deadline_s)))

@@ -171,6 +171,26 @@ def test_evaluate_fits_clones_and_leaves_the_callers_detector_as_it_was(local):
         for f, d in result.fitted.items())
 
 
+def test_a_detector_that_is_not_causal_is_ranked_a_reference_from_python_too(local):
+    """The workflow refuses a non-causal run that is not a reference; scored from Python
+    its record says it is not causal, and the tables rank it a reference row, while a
+    causal run calibrated on other dates is ranked honest beside it."""
+    from alfa_bench.methods.end_of_flight import EndOfFlight
+
+    late = ab.evaluate(EndOfFlight(), local)
+    assert {r["causal"] for r in late.records} == {False}
+    assert set(late.summary["block"]) == set(late.per_flight["block"]) == {"reference"}
+    assert "rank" not in late.summary or late.summary["rank"].isna().all()
+    fair = ab.evaluate("residual_bank", local)
+    assert {r["causal"] for r in fair.records} == {True}
+    assert {r["calibration"]["group_by"] for r in fair.records} == {"date"}
+    table = ab.compare(late, fair).set_index(["subset", "method"])
+    for subset in evaluation._subsets(local.config):
+        assert table.at[(subset, "endofflight"), "block"] == "reference"
+        assert table.at[(subset, "residual_bank"), "block"] == "honest"
+        assert table.at[(subset, "residual_bank"), "rank"] == 1
+
+
 class Constant(ab.MaximaThresholds, Detector):
     """A score that never varies: its per-flight maxima give no threshold."""
 

@@ -24,15 +24,30 @@ def _per_flight(run: str, alarms: list) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+MANIFEST = pd.DataFrame({"flight": list(FLIGHTS), "subsets": ["all;no_emr"] * 3,
+                         "ground_truth": True})
+
+#: no flight off the common ground (left_out.csv)
+NONE_LEFT_OUT = pd.DataFrame(columns=["flight", "subsets", "stage", "runs", "error"])
+
+
+def _comparison(runs: dict) -> pd.DataFrame:
+    """The comparison's rows the table reads, on ``no_emr``: per run, its supervision,
+    configurations, whether it beats silence and its scored flights."""
+    return pd.DataFrame([{"subset": "no_emr", "method": m, "calibration": c,
+                          "configurations": n, "beats_silence": b, "flights": f}
+                         for m, (c, n, b, f) in runs.items()])
+
+
 def test_each_learner_gets_a_cell_per_run_and_its_chosen_configurations():
-    manifest = pd.DataFrame({"flight": list(FLIGHTS), "subsets": ["all;no_emr"] * 3,
-                             "ground_truth": True})
+    manifest = MANIFEST
     per_flight = pd.concat([_per_flight("knn", [101.0, None, 50.0]),
                             _per_flight("knn_nested", [101.0, 82.0, None])])
-    comparison = pd.DataFrame({
-        "subset": ["no_emr", "no_emr", "all"], "method": ["knn", "knn_nested", "knn"],
-        "calibration": ["fault-free only", "supervised (labelled flights)", "x"],
-        "configurations": [1, 9, 1], "beats_silence": [False, True, True]})
+    comparison = pd.concat([_comparison({
+        "knn": ("fault-free only", 1, False, 3),
+        "knn_nested": ("supervised (labelled flights)", 9, True, 3)}), pd.DataFrame([{
+            "subset": "all", "method": "knn", "calibration": "x", "configurations": 1,
+            "beats_silence": True, "flights": 3}])], ignore_index=True)
     records = [{"calibration": {"fold": d, "fitted": {"chosen": {
         "window_s": 5.0, "params": {"n_neighbors": k}}}}}
         for d, k in [("a", 5), ("a", 5), ("b", 20), ("c", 5)]]
@@ -41,7 +56,7 @@ def test_each_learner_gets_a_cell_per_run_and_its_chosen_configurations():
     rows = [{"learner": "KNN", "windows": "knn", "windows_best": "knn_nested",
              "residuals": "knn_residuals"}]
     table = features_learners(per_flight, comparison, manifest, rows, "no_emr", 0.9,
-                              {"knn_nested": chosen}).set_index("run")
+                              {"knn_nested": chosen}, NONE_LEFT_OUT).set_index("run")
     assert list(table.index) == ["knn", "knn_nested"]            # the residual run: not run
     assert table.loc["knn", ["detected", "fault_free_alarmed"]].tolist() == [1, 1]
     assert table.loc["knn_nested", ["detected", "fault_free_alarmed"]].tolist() == [2, 0]
@@ -51,3 +66,26 @@ def test_each_learner_gets_a_cell_per_run_and_its_chosen_configurations():
     assert "| KNN | `knn`: 1 of 2, 1 of 1 fault-free alarmed" in md
     assert "best of 9: window 5 s, n_neighbors 5 (2 dates)" in md
     assert "does not beat silence" in md and "| physical residuals" not in md
+
+
+def test_each_run_is_counted_on_the_common_ground():
+    """A flight some ranked run failed on is off the common ground the comparison ranks
+    on: no cell counts it, though the runs of the table scored it; a run the comparison
+    scored on no flight has no cell."""
+    second = list(FLIGHTS)[1]
+    per_flight = pd.concat([_per_flight("knn", [101.0, None, 50.0]),
+                            _per_flight("knn_nested", [101.0, 82.0, None])])
+    comparison = _comparison({"knn": ("fault-free only", 1, False, 2),
+                              "knn_nested": ("fault-free only", 9, True, 2),
+                              "knn_residuals": ("fault-free only", 1, None, 0)})
+    left_out = pd.DataFrame([{"flight": second, "subsets": "all;no_emr",
+                              "stage": "calibration", "runs": "other",
+                              "error": "other: too few dates"}])
+    rows = [{"learner": "KNN", "windows": "knn", "windows_best": "knn_nested",
+             "residuals": "knn_residuals"}]
+    table = features_learners(per_flight, comparison, MANIFEST, rows, "no_emr", 0.9, {},
+                              left_out).set_index("run")
+    assert list(table.index) == ["knn", "knn_nested"]
+    assert table.loc["knn_nested", ["faulty_flights", "detected"]].tolist() == [1, 1]
+    assert table.loc["knn", ["faulty_flights", "detected", "fault_free_alarmed"]].tolist() == [
+        1, 1, 1]

@@ -1,5 +1,6 @@
 """The deadline, the intervals and the paired test of the honest benchmark."""
 
+import io
 import math
 
 import pytest
@@ -71,6 +72,9 @@ def test_blocks_follow_the_role_and_the_inputs():
     assert block({"role": "reference", "reads_actuators": True}) == "reference"
     assert block({"role": "method", "reads_actuators": True}) == "reads actuators"
     assert block({"role": "method", "reads_actuators": False}) == "honest"
+    # what the detector declares: one that sees the whole flight is a reference row
+    assert block({"role": "method", "reads_actuators": False, "causal": False}) == "reference"
+    assert block({"role": "method", "reads_actuators": False, "causal": True}) == "honest"
 
 
 def test_only_a_calibration_by_date_is_ranked_honest():
@@ -172,10 +176,101 @@ def test_runs_are_ranked_on_the_common_ground_and_a_run_that_failed_is_flagged(
     assert first not in {r["flight"] for r in kept}
     assert left_out.to_dict(orient="records") == [{
         "flight": first, "subsets": corpus_manifest.set_index("flight").at[first, "subsets"],
-        "stage": "calibration", "runs": "partial", "error": "too few fault-free flights"}]
+        "stage": "calibration", "runs": "partial",
+        "error": "partial: too few fault-free flights"}]
     text = comparison_markdown(table.reset_index())
     assert "partial (FLAGGED: failed on 1 flight; ranked on the common ground)" in text
     assert f"({len(flights)} flights, {len(flights) - 1} on the common ground, 1 left out" in text
+
+
+def _failure(flight, method, error, stage="calibration"):
+    return {"flight": flight, "stage": stage, "method": method, "error": error, "subsets": ""}
+
+
+def test_only_the_ranked_runs_decide_the_common_ground(corpus_manifest):
+    """A reference run and an actuator-reading one that failed on a flight leave it on
+    the common ground: the ranked runs are scored on every flight, and each of the two
+    on those it scored, which its row counts and its flag in the Markdown says."""
+    import pandas as pd
+
+    from alfa_bench.outputs.tables import common_ground, comparison_markdown, summary_table
+
+    flights = corpus_manifest.loc[corpus_manifest["ground_truth"]]
+    second, third = flights["flight"].iloc[1], flights["flight"].iloc[2]
+    records = []
+    for r in flights.itertuples():
+        onset = None if math.isnan(r.onset_s) else r.onset_s
+        late = None if onset is None else onset + 1
+        records.append(_record("fair", r.flight, onset, late))
+        if r.flight != second:
+            records.append(_record("ref", r.flight, onset, late, role="reference"))
+        if r.flight != third:
+            records.append(_record("servo", r.flight, onset, late, actuators=True))
+    failures = pd.DataFrame([_failure(second, "ref", "no fold"),
+                             _failure(third, "servo", "no fold")])
+    kept, left_out = common_ground(records, corpus_manifest, failures)
+    assert left_out.empty and len(kept) == len(records)
+    table = comparison_table(records, corpus_manifest, ["all"], 5.0, failures)
+    table = table.set_index("method")
+    n = len(flights)
+    assert table.loc["fair", "flights"] == n and table.loc["fair", "rank"] == 1
+    assert table.loc["ref", "flights"] == table.loc["servo", "flights"] == n - 1
+    assert (table["excluded"] == 0).all()
+    assert list(table["failed_flights"]) == [0, 1, 1]
+    summary = summary_table(records, corpus_manifest, ["all"], 5.0, failures)
+    assert dict(zip(summary["method"], summary["flights"], strict=True)) == {
+        "fair": n, "ref": n - 1, "servo": n - 1}
+    text = comparison_markdown(table.reset_index())
+    assert f"ref (FLAGGED: failed on 1 flight; scored on {n - 1} flights of the" in text
+    assert f"`all` ({n} flights;" in text and "left out" not in text
+
+
+def test_a_left_out_flight_quotes_every_runs_error(corpus_manifest):
+    import pandas as pd
+
+    from alfa_bench.outputs.tables import common_ground, left_out_markdown
+
+    flights = corpus_manifest.loc[corpus_manifest["ground_truth"], "flight"]
+    first = flights.iloc[0]
+    records = [_record(m, f, None, None) for m in ("a", "b", "c") for f in flights
+               if f != first or m == "c"]
+    failures = pd.DataFrame([_failure(first, "b", "too few dates"),
+                             _failure(first, "a", "scores do not vary")])
+    _, left_out = common_ground(records, corpus_manifest, failures)
+    assert list(left_out["runs"]) == ["a;b"]
+    assert list(left_out["error"]) == ["a: scores do not vary | b: too few dates"]
+    assert "a: scores do not vary | b: too few dates" in left_out_markdown(left_out, ["all"])
+
+
+def test_a_run_that_scored_no_flight_has_a_row_saying_so(corpus_manifest):
+    """A run that failed on every flight of a subset has a comparison row with no
+    flight scored and no scores, as the Markdown's list of runs not scored says; it
+    takes no flight from the others and no line of the Markdown's tables."""
+    import pandas as pd
+
+    from alfa_bench.outputs.tables import comparison_markdown, unscored_notes
+
+    flights = corpus_manifest.loc[corpus_manifest["ground_truth"], "flight"]
+    records = [_record("a", f, None, None) for f in flights]
+    failures = pd.DataFrame([_failure(f, "b", "scores do not vary") for f in flights])
+    table = comparison_table(records, corpus_manifest, ["all", "icra22"], 5.0, failures)
+    for subset in ("all", "icra22"):
+        rows = table[table["subset"] == subset].set_index("method")
+        assert list(rows.index) == ["a", "b"]
+        assert rows.loc["a", "flights"] == len(
+            [f for f in flights if subset in corpus_manifest.set_index("flight").at[f, "subsets"]])
+        assert rows.loc["b", "flights"] == 0 and rows.loc["b", "not_ranked"] == "not scored"
+        assert rows.loc["b", "failed_flights"] == rows.loc["a", "flights"]
+        assert math.isnan(rows.loc["b", "accuracy"]) and rows.loc["b", "block"] == ""
+    assert list(table.columns[:3]) == ["subset", "method", "block"]
+    notes = unscored_notes(table, failures, corpus_manifest, ["all", "icra22"])
+    assert "`b` on `all`" in notes and "`b` on `icra22`" in notes
+    text = comparison_markdown(table, notes)
+    assert "| not scored |" not in text and "`b` on `all`" in text
+    # the counts of the scored rows stay whole numbers beside the empty cells
+    assert "| 0 of " in text and ".0 of " not in text
+    csv = pd.read_csv(io.StringIO(table.to_csv(index=False)))
+    assert list(csv["flights"]) == list(table["flights"]) and csv["tn"].iloc[0] == len(flights)
 
 
 def test_a_run_with_no_record_and_no_failure_is_an_error(corpus_manifest):
