@@ -137,4 +137,5 @@ DETECT_JOB = (f"{shlex.quote(sys.executable)} -m alfa_bench.workflow.detect_job 
 onstart:
     if workflow.local_exec and any(j.rule.name.startswith("detect")
                                    for j in workflow.dag.needrun_jobs()):
-        forkserver.start(SERVER_ENV, JOB_CONFIG, "results/logs/detect_server.log")
+        forkserver.start(SERVER_ENV, "alfa_bench.workflow.detect_job:server_jobs", [JOB_CONFIG],
+                         "results/logs/detect_server.log")
