@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import ast
 import importlib
+import re
 from functools import cache
 from pathlib import Path
 
@@ -64,7 +65,7 @@ def _imported(path: Path, package: str, roots: tuple[str, ...]) -> list[str]:
     """The modules under ``roots`` that the source at ``path`` imports, anywhere in it (a
     function's import too); ``package`` resolves its relative imports."""
     found = []
-    for node in ast.walk(ast.parse(path.read_text())):
+    for node in _import_statements(path.read_text()):
         if isinstance(node, ast.Import):
             found += [a.name for a in node.names if a.name.startswith(roots)]
         elif isinstance(node, ast.ImportFrom):
@@ -75,6 +76,25 @@ def _imported(path: Path, package: str, roots: tuple[str, ...]) -> list[str]:
             names = [] if node.module is None else [base]
             found += [m for m in (*names, *(f"{base}.{a.name}" for a in node.names))
                       if m == base or _locate(m) is not None]
+    return found
+
+
+#: a line that starts an import statement, and a parenthesised one's other lines
+_IMPORT = re.compile(r"^[ \t]*(?:from[ \t]+[\w.]+[ \t]+import[ \t]*(?:\([^)]*\).*|.*)"
+                     r"|import[ \t]+.*)$", re.MULTILINE)
+
+
+def _import_statements(text: str) -> list[ast.stmt]:
+    """The import statements of the source ``text``, anywhere in it (a function's too),
+    parsed one by one: parsing the whole module (the workflow does it for every module
+    of every job, on each parse) costs over ten times as much. A line of a string that
+    reads as an import is one too: a dependency more, never one less."""
+    found = []
+    for match in _IMPORT.finditer(text):
+        try:
+            found += ast.parse(match.group().strip()).body
+        except SyntaxError:
+            continue                 # prose in a docstring
     return found
 
 
