@@ -13,7 +13,7 @@ configfile: "config/config.yaml"
 
 # a wrong key or value ends the run on what it is and where, not on the schema
 if _problem := config_problem(config, f"{workflow.basedir}/config/schema.yaml",
-                              workflow.configfiles):
+                              workflow.configfiles, dict(workflow.config_settings.config)):
     stop(_problem)
 validate(config, "config/schema.yaml")
 

@@ -11,6 +11,7 @@ and what is allowed there (:func:`config_problem`, which the workflow prints too
 from __future__ import annotations
 
 import difflib
+import json
 import os
 from importlib.resources import files
 from pathlib import Path
@@ -49,27 +50,35 @@ def load_config(path: str | os.PathLike | None = None) -> dict:
     return config
 
 
-def _found_in(files, path: list) -> str:
-    """Which of the config ``files`` sets the key at ``path`` (the last one wins)."""
-    found = None
-    for f in files:
-        node = yaml.safe_load(Path(f).read_text()) if Path(f).is_file() else None
-        for key in path:
-            node = node.get(key) if isinstance(node, dict) and key in node else None
-            if node is None:
-                break
-        else:
-            found = f
-    return f"in {found}" if found else "given with --config"
+def _sets(node, path: list) -> bool:
+    """Whether the nested mapping ``node`` sets the key at ``path``."""
+    for key in path:
+        if not isinstance(node, dict) or key not in node:
+            return False
+        node = node[key]
+    return True
 
 
-def config_problem(config: dict, schema_path: str | Path, files) -> str | None:
+def _found_in(files, path: list, overrides: dict) -> str:
+    """Where the key at ``path`` is set: by a ``--config`` override of ``overrides``
+    (which win), else by the last of the config ``files`` that sets it."""
+    if path and _sets(overrides, path):
+        return f"given with --config {path[0]}={json.dumps(overrides[path[0]])}"
+    found = [f for f in files if Path(f).is_file()
+             and _sets(yaml.safe_load(Path(f).read_text()), path)]
+    return f"in {found[-1]}" if found else "given with --config"
+
+
+def config_problem(config: dict, schema_path: str | Path, files,
+                   overrides: dict | None = None) -> str | None:
     """The first way ``config`` breaks its schema, in words: the key and where it is
-    set (which of the config ``files``), and for an unknown key the keys allowed
-    there, the nearest first; None if it does not."""
+    set (a ``--config`` override of ``overrides``, Snakemake's ``key=value`` pairs, or
+    else which of the config ``files``), and for an unknown key the keys allowed there,
+    the nearest first; None if it does not."""
     import jsonschema
     from jsonschema.exceptions import best_match
 
+    overrides = overrides or {}
     schema = yaml.safe_load(Path(schema_path).read_text())
     error = best_match(jsonschema.Draft202012Validator(schema).iter_errors(config))
     if error is None:
@@ -80,9 +89,10 @@ def config_problem(config: dict, schema_path: str | Path, files) -> str | None:
         key = sorted(set(error.instance) - set(allowed))[0]
         near = difflib.get_close_matches(key, allowed, n=1)
         under = ".".join(map(str, path)) or "the top level"
-        return (f"config: unknown key {key!r} under {under} ({_found_in(files, [*path, key])})."
+        where = _found_in(files, [*path, key], overrides)
+        return (f"config: unknown key {key!r} under {under} ({where})."
                 + (f" Did you mean {near[0]!r}?" if near else "")
                 + f"\nAllowed there: {', '.join(allowed)}.")
     name = ".".join(map(str, path)) or "(top level)"
     message = error.message if len(error.message) < 200 else error.message[:200] + " ..."
-    return f"config {name}: {message} ({_found_in(files, path)})."
+    return f"config {name}: {message} ({_found_in(files, path, overrides)})."

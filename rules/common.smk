@@ -9,7 +9,7 @@ from snakemake.logging import logger
 
 from alfa_bench.workflow.preflight import alfa_dir_problem, failure_message, stop
 from alfa_bench.workflow import forkserver
-from alfa_bench.workflow.dependencies import module_sources
+from alfa_bench.workflow.dependencies import module_sources, script_sources
 from alfa_bench.workflow.detect_job import SERVER_ENV, write_job_config
 from alfa_bench.workflow.logs import failed_flights_line
 from alfa_bench.workflow.stale import remove, stale_results
@@ -69,13 +69,21 @@ if STALE and workflow.is_main_process:
 
 
 def detector_code(method):
-    """The source files of the modules ``method``'s detector runs on: a job's input, so
-    that a changed module re-runs the jobs of the detectors that use it, and no other.
-    A detector that wraps another (nested selection: ``params.detector``) runs on both."""
+    """The source files of the modules ``method``'s job runs on: the job's own
+    (workflow/detect_job.py) and its detector's; a job's input, so that a changed module
+    re-runs the jobs of the detectors that use it, and no other. A detector that wraps
+    another (nested selection: ``params.detector``) runs on both."""
     spec = config["methods"][method]
     names = [spec["detector"], (spec.get("params") or {}).get("detector")]
-    modules = [detector_module(n) for n in names if n]
+    modules = ["alfa_bench.workflow.detect_job", *(detector_module(n) for n in names if n)]
     return sorted({f for m in modules if m for f in module_sources(m)})
+
+
+def script_code(name):
+    """The source files of the project's modules that ``scripts/<name>.py`` imports: its
+    rule's input, so that a changed module re-runs the jobs whose scripts use it, and
+    those after them. (The download's is left out: the archive is the config's MD5's.)"""
+    return script_sources(Path(workflow.basedir) / "scripts" / f"{name}.py")
 
 
 @functools.cache
@@ -129,4 +137,5 @@ DETECT_JOB = (f"{shlex.quote(sys.executable)} -m alfa_bench.workflow.detect_job 
 onstart:
     if workflow.local_exec and any(j.rule.name.startswith("detect")
                                    for j in workflow.dag.needrun_jobs()):
-        forkserver.start(SERVER_ENV, JOB_CONFIG, "results/logs/detect_server.log")
+        forkserver.start(SERVER_ENV, "alfa_bench.workflow.detect_job:server_jobs", [JOB_CONFIG],
+                         "results/logs/detect_server.log")

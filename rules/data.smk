@@ -24,6 +24,7 @@ if DOWNLOAD:
 rule manifest:
     input:
         processed=PROCESSED,
+        code=script_code("manifest"),
     output:
         manifest="results/flights.csv",
         failures="results/load_failures.csv",

@@ -6,6 +6,7 @@ rule inject:
     input:
         manifest="results/flights.csv",
         cache="results/cache",
+        code=script_code("inject"),
     output:
         manifest="results/injected/flights.csv",
         # flight-sensor pairs left out: the sensor's topic is missing or not measured
@@ -29,6 +30,7 @@ rule injected_csv:
     input:
         manifest="results/flights.csv",
         processed=PROCESSED,
+        code=script_code("injected_csv"),
     output:
         processed=directory(INJECTED_PROCESSED),
     params:
@@ -47,6 +49,7 @@ rule detectability:
         calibrate_on="results/flights.csv",
         detections=expand("results/injected/detections/{method}", method=DETECTORS),
         clean=expand("results/detections/{method}", method=DETECTORS),
+        code=script_code("detectability"),
     output:
         csv=report("results/tables/detectability.csv",
                    caption="../report/detectability_table.rst", category="Sensor faults"),
@@ -72,6 +75,7 @@ rule isolation:
         detections=expand("results/detections/{method}", method=DETECTORS),
         injected_detections=expand("results/injected/detections/{method}",
                                    method=DETECTORS),
+        code=script_code("isolation"),
     output:
         sensors_csv="results/tables/isolation_sensors.csv",
         sensors_md=report("results/tables/isolation_sensors.md",

@@ -34,6 +34,7 @@ rule paper_sources:
         left_out="results/tables/left_out.csv",
         tex=PAPER_DIR / "paper.tex",
         markdown=PAPER_DIR / "paper.template.md",
+        code=script_code("paper"),
     output:
         macros="paper/build/results.tex",
         markdown=report("paper/build/paper.md", caption="../report/paper.rst",

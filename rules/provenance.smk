@@ -7,6 +7,7 @@ rule provenance:
         traces=expand("results/traces/{method}", method=METHODS),
         injected=expand("results/injected/detections/{method}", method=DETECTORS),
         grid=rules.inject.output,
+        code=script_code("provenance"),
     output:
         RUN_FILE,
     params:

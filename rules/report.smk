@@ -3,6 +3,7 @@
 rule index_screenshot:
     input:
         "results/index.html",
+        code=script_code("index_screenshot"),
     output:
         "docs/index.png",
     resources:
@@ -17,6 +18,7 @@ rule index_screenshot:
 rule report_screenshot:
     input:
         "results/report.html",
+        code=script_code("report_screenshot"),
     output:
         "docs/report.png",
     resources:

@@ -5,6 +5,7 @@ rule rerun_logs:
         manifest="results/flights.csv",
         cache="results/cache",
         traces=expand("results/traces/{method}", method=METHODS),
+        code=script_code("rerun_logs"),
     output:
         directory("results/rerun"),
     params:
@@ -26,6 +27,7 @@ rule rerun_logs:
 rule viewer_screenshot:
     input:
         "results/rerun",
+        code=script_code("viewer_screenshot"),
     output:
         "docs/viewer.png",
     params:

@@ -5,6 +5,7 @@ rule sweep:
         manifest="results/flights.csv",
         detections=expand("results/detections/{method}", method=METHODS),
         traces=expand("results/traces/{method}", method=METHODS),
+        code=script_code("sweep"),
     output:
         # not in the report: 7.6 MB of rows no reader reads there (the figure is)
         csv="results/tables/sweep.csv",
@@ -30,6 +31,7 @@ rule flight_figures:
         manifest="results/flights.csv",
         detections=expand("results/detections/{method}", method=METHODS),
         panels=expand("results/figure_parts/{method}", method=METHODS),
+        code=script_code("flight_figures"),
     output:
         report(directory("results/figures/flights"), patterns=["{flight}.png"],
                caption="../report/flight.rst", category="Flights",

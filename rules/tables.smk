@@ -11,6 +11,7 @@ rule tables:
         load_failures="results/load_failures.csv",
         detections=expand("results/detections/{method}", method=METHODS),
         leakage="results/tables/leakage.csv",
+        code=script_code("tables"),
     output:
         failures=report("results/tables/failures.csv", caption="../report/failures.rst",
                         category="Comparison"),
@@ -56,6 +57,7 @@ rule index_page:
         by_fault="results/tables/by_fault.csv",
         left_out="results/tables/left_out.csv",
         sweep="results/figures/sweep.png",
+        code=script_code("index_page"),
     output:
         "results/index.html",
     params:
@@ -76,6 +78,7 @@ rule stability_refit:
         cache="results/cache",
         detections=expand("results/detections/{method}",
                           method=config["stability"]["refit"]["runs"]),
+        code=script_code("stability_refit"),
     output:
         csv="results/tables/stability_refit.csv",
         md="results/tables/stability_refit.md",
@@ -98,6 +101,7 @@ rule per_flight:
         manifest="results/flights.csv",
         detections=expand("results/detections/{method}", method=METHODS),
         traces=expand("results/traces/{method}", method=METHODS),
+        code=script_code("per_flight"),
     output:
         csv="results/tables/per_flight.csv",
         md="results/tables/per_flight.md",
@@ -122,6 +126,7 @@ rule protocol_steps:
     input:
         manifest="results/flights.csv",
         per_flight="results/tables/per_flight.csv",
+        code=script_code("protocol_steps"),
     output:
         csv="results/tables/protocol_steps.csv",
         md="results/tables/protocol_steps.md",
@@ -150,6 +155,7 @@ rule features_learners:
         nested=[f"results/detections/{row[key]}"
                 for row in config.get("features_learners", [])
                 for key in ("windows_best", "physical_best") if row.get(key) in METHODS],
+        code=script_code("features_learners"),
     output:
         csv="results/tables/features_learners.csv",
         md="results/tables/features_learners.md",
@@ -173,6 +179,7 @@ rule runtime:
         detections=expand("results/detections/{method}", method=METHODS),
         injected=expand("results/injected/detections/{method}", method=DETECTORS),
         benchmarks=expand("results/benchmarks/detect/{method}.tsv", method=METHODS),
+        code=script_code("runtime"),
     output:
         csv="results/runtime/runtime.csv",
         md="results/runtime/runtime.md",
@@ -192,6 +199,7 @@ rule deadline:
     input:
         manifest="results/flights.csv",
         detections=expand("results/detections/{method}", method=METHODS),
+        code=script_code("deadline"),
     output:
         csv="results/tables/deadline.csv",
         md=report("results/tables/deadline.md", caption="../report/deadline_table.rst",
@@ -221,6 +229,7 @@ rule leakage:
     input:
         manifest="results/flights.csv",
         cache="results/cache",
+        code=script_code("leakage"),
     output:
         csv="results/tables/leakage.csv",
         md="results/tables/leakage.md",
@@ -241,6 +250,7 @@ rule ceiling:
     input:
         manifest="results/flights.csv",
         cache="results/cache",
+        code=script_code("ceiling"),
     output:
         csv="results/tables/ceiling.csv",
         md="results/tables/ceiling.md",

@@ -7,6 +7,9 @@ from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
+# the outputs the run file lists, not the source files the rule takes as inputs too
+code = set(sm.input.code)
 write_run_file(sm.output[0], run_provenance(sm.config, read_manifest(sm.input.manifest)),
-               [*sm.input, "results/load_failures.csv"],
+               [*(f for f in sm.input if f not in code),
+                "results/load_failures.csv"],
                unchecked=sm.params.unchecked)

@@ -11,6 +11,7 @@ import subprocess
 import sys
 import time
 
+from alfa_bench.workflow.detect_job import parse
 from alfa_bench.workflow.forkserver import serve
 
 prepared = []
@@ -36,6 +37,10 @@ def handle(argv):
             print(subprocess.run(["false"]).returncode)
         case "sleep":                # writes its pid, then runs until killed
             with open(argv[1], "w") as f:
+                f.write(str(os.getpid()))
+            time.sleep(60)
+        case "sleep-job":            # a detect job's arguments: its pid in its benchmark
+            with open(parse(argv).benchmark, "w") as f:
                 f.write(str(os.getpid()))
             time.sleep(60)
         case "crash":

@@ -120,6 +120,29 @@ def test_a_killed_client_takes_its_job_with_it(server, tmp_path):
     _wait(lambda: _gone(pid), "the job outlived its client")
 
 
+def test_a_job_killed_by_the_kernel_names_the_kill_in_its_log(server, tmp_path):
+    """The out-of-memory killer's SIGKILL leaves the fork no time to write a word: the
+    job's log names the signal and what it likely means, and the job fails with the
+    shell's status for it (128 + 9)."""
+    pid_file, log = tmp_path / "pid", tmp_path / "job.log"
+    files = [f"--{a}={tmp_path / a}" for a in ("manifest", "cache", "detections", "traces",
+                                                "panels")]
+    job = subprocess.Popen([sys.executable, "-m", "alfa_bench.workflow.detect_job",
+                            "sleep-job", *files, "--config", str(tmp_path / "config.json"),
+                            "--benchmark", str(pid_file), "--log", str(log)],
+                           env={**os.environ, SERVER_ENV: str(server)},
+                           stderr=subprocess.PIPE, text=True)
+    _wait(lambda: pid_file.exists() and pid_file.read_text(), "the job did not start")
+    os.kill(int(pid_file.read_text()), signal.SIGKILL)
+    _, err = job.communicate(timeout=60)
+    assert job.returncode == 128 + signal.SIGKILL, err
+    line = log.read_text().strip()
+    assert line.startswith("alfa-bench: detect job sleep-job: the job's process was killed "
+                           "by SIGKILL (Killed): most likely the kernel's out-of-memory "
+                           "killer"), line
+    assert line in err
+
+
 def test_without_a_server_a_job_runs_in_its_own_process(tmp_path):
     assert client(tmp_path / "none.sock", "echo").returncode == 99
     # the rule's command: a socket that is gone, so the job runs here, and meets its
@@ -150,7 +173,8 @@ def test_started_and_stopped_by_the_workflow_with_one_thread_per_job(tmp_path):
     config = tmp_path / "config.json"
     config.write_text(json.dumps({"methods": {}}))
     env = "ALFA_BENCH_TEST_SERVER"
-    path = forkserver.start(env, config, tmp_path / "server.log")
+    path = forkserver.start(env, "alfa_bench.workflow.detect_job:server_jobs", [config],
+                            tmp_path / "server.log")
     try:
         assert os.environ[env] == path and os.path.exists(path)
         (server,) = forkserver._SERVERS.values()

@@ -54,3 +54,20 @@ def test_a_relative_import_of_a_room_above_is_seen(tmp_path):
         assert any(m.startswith(seen) for m in _imports(path, "alfa_bench.analysis")), line
     path.write_text("from .scoring import score\nfrom ..data import SIGNALS\n")
     assert not [m for m in _imports(path, "alfa_bench.analysis") if m.startswith(ABOVE)]
+
+
+def test_the_workflows_modules_import_in_no_circle():
+    """The fork server takes what it runs as an argument (``start``'s ``jobs``): it
+    imports no module of the workflow that imports it, as it once did the detect job's."""
+    room = {p.stem: p for p in _room("workflow") if p.stem != "__init__"}
+    graph = {name: {m.split(".")[2] for m in _imports(path, "alfa_bench.workflow")
+                    if m.startswith("alfa_bench.workflow.")} & set(room)
+             for name, path in room.items()}
+    assert "forkserver" in graph["detect_job"]
+
+    def circle(name, path):
+        if name in path:
+            return path[path.index(name):] + [name]
+        return next((c for n in sorted(graph[name]) if (c := circle(n, [*path, name]))), None)
+
+    assert not [c for name in graph if (c := circle(name, []))]

@@ -29,7 +29,7 @@ import time
 from pathlib import Path
 
 __all__ = ["BENCHMARK_COLUMNS", "CONFIG_ENV", "SERVER_ENV", "code_changed", "forked", "main",
-           "parse", "prepare", "preload", "run", "write_job_config"]
+           "parse", "prepare", "preload", "run", "server_jobs", "write_job_config"]
 
 _START = time.perf_counter()
 #: the environment variable naming the fork server's socket, set by the workflow
@@ -168,6 +168,25 @@ def run(args: argparse.Namespace, started: float = _START) -> None:
     _write_benchmark(Path(args.benchmark), time.perf_counter() - started)
 
 
+def server_jobs(config_file: str) -> tuple:
+    """The fork server's three steps (:func:`.forkserver.serve`) for the detect jobs of
+    the workflow config at ``config_file`` (:func:`write_job_config`): preload what they
+    run on, prepare the flights a job reads (unless a module changed since the preload:
+    the job then runs on its own), and run the job in the fork."""
+    def preload_config():
+        preload(json.loads(Path(config_file).read_text()))
+
+    def prepare_job(argv):
+        if code_changed():
+            print("a module changed since the server loaded it: jobs run on their own",
+                  file=sys.stderr)
+            return False
+        prepare(parse(argv))
+        return True
+
+    return preload_config, prepare_job, forked
+
+
 def forked(argv: list[str]) -> None:
     """The job of ``argv`` in a child of the fork server, timed from the fork."""
     run(parse(argv), time.perf_counter())
@@ -192,9 +211,18 @@ def main(argv: list[str] | None = None) -> int:
         argv = [*argv, "--config", os.environ[CONFIG_ENV]]    # this workflow's, to the server
     server = os.environ.get(SERVER_ENV)
     if server:
-        from .forkserver import submit
+        from .forkserver import killed, submit
 
         status = submit(server, argv)
+        if status is not None and status < 0:
+            # the fork could write nothing: its log says what ended it; the status is
+            # the shell's for a process killed by a signal
+            args = parse(argv)
+            line = f"alfa-bench: detect job {args.method}: {killed(-status)}"
+            with open(args.log, "a") as log:
+                print(line, file=log)
+            print(line, file=sys.stderr)
+            return 128 - status
         if status is not None:
             return status
     run(parse(argv))

@@ -12,7 +12,13 @@ loaded (:func:`~.detect_job.prepare`), and forks; the child, sharing the loaded 
 and flights copy-on-write, runs the job as it would run alone
 (:func:`~.detect_job.forked`), writes its output to the client's streams, and sends
 its exit status back, which becomes the client's. A client killed by Snakemake takes
-its child with it.
+its child with it. A child killed by a signal (the kernel's out-of-memory killer
+sends SIGKILL) sends nothing: the fork between the server and it, which waits for it,
+sends the signal instead, and the client names it (:func:`killed`).
+
+The server knows nothing of what it runs: :func:`start` names a function that returns
+the three steps (for the detect jobs, :func:`~.detect_job.server_jobs`), which the
+server's process imports.
 
 Where no server answers (a cluster executor, which starts none; a server gone), the
 client runs the job in its own process: the same function, the same files.
@@ -23,6 +29,7 @@ The server stops with the Snakemake process that started it (:func:`stop`, from
 
 from __future__ import annotations
 
+import importlib
 import json
 import os
 import signal
@@ -35,7 +42,7 @@ import time
 import traceback
 from pathlib import Path
 
-__all__ = ["serve", "start", "stop", "submit"]
+__all__ = ["killed", "serve", "start", "stop", "submit"]
 
 _STARTED, _EXITED = b"+", b"="
 #: the threads of the numerical libraries, fixed when they load: one, as Snakemake
@@ -45,12 +52,34 @@ _ONE_THREAD = dict.fromkeys(["OMP_NUM_THREADS", "GOTO_NUM_THREADS", "OPENBLAS_NU
                              "NUMEXPR_NUM_THREADS"], "1")
 #: the servers this process started, by socket path
 _SERVERS: dict[str, subprocess.Popen] = {}
+#: what a signal that ends a job most likely means
+_MEANINGS = {
+    signal.SIGKILL: "most likely the kernel's out-of-memory killer (`dmesg` names the "
+                    "process it killed): give the job more memory (its rule's mem_mb) or "
+                    "run fewer jobs at once (--cores)",
+    signal.SIGSEGV: "a crash in compiled code (numba's, a library's)",
+    signal.SIGBUS: "a crash in compiled code, or a file it had mapped was cut short",
+    signal.SIGTERM: "stopped from outside: the workflow interrupted, or a time limit",
+    signal.SIGINT: "interrupted (Ctrl-C)",
+}
+
+
+def killed(signum: int) -> str:
+    """A line naming signal ``signum``, which ended a job's process, and what it most
+    likely means."""
+    try:
+        name = signal.Signals(signum).name
+    except ValueError:
+        name = f"signal {signum}"
+    return (f"the job's process was killed by {name} ({signal.strsignal(signum)}): "
+            + _MEANINGS.get(signum, "sent from outside the job"))
 
 
 def submit(path: str, argv: list[str]) -> int | None:
     """Run the job of ``argv`` on the server at ``path``, with this process's standard
-    output and error: its exit status, or None when no server took it (the caller
-    runs it itself)."""
+    output and error: its exit status (the negative number of the signal that killed
+    it, as :mod:`subprocess` gives), or None when no server took it (the caller runs it
+    itself)."""
     client = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
     try:
         client.connect(path)
@@ -70,7 +99,7 @@ def submit(path: str, argv: list[str]) -> int | None:
         print(f"alfa-bench: the detect job's process (forked by the server at {path}) "
               "ended without an exit status; see the job's log", file=sys.stderr)
         return 1
-    return int(reply.split(_EXITED, 1)[1])
+    return int(reply.split(_EXITED)[1])
 
 
 def _receive(conn: socket.socket) -> tuple[str, list[str], list[int]]:
@@ -87,14 +116,32 @@ def _receive(conn: socket.socket) -> tuple[str, list[str], list[int]]:
     return request["cwd"], request["argv"], fds
 
 
+def _watch(conn: socket.socket, argv: list[str], fds: list[int], handle) -> None:
+    """In the server's fork: the job in a fork of this one, waited for, so that a
+    signal that kills it (it can send no status then) reaches the client. The server
+    lets the kernel reap its forks, and so cannot learn how they ended."""
+    signal.signal(signal.SIGCHLD, signal.SIG_DFL)    # this fork's, and the job's own
+    conn.sendall(_STARTED)
+    pid = os.fork()
+    if pid == 0:
+        _child(conn, argv, fds, handle)
+    for fd in fds:
+        os.close(fd)
+    _, status = os.waitpid(pid, 0)
+    if os.WIFSIGNALED(status):
+        try:
+            conn.sendall(_EXITED + str(-os.WTERMSIG(status)).encode())
+        except OSError:
+            pass                     # the client is gone too
+    os._exit(0)
+
+
 def _child(conn: socket.socket, argv: list[str], fds: list[int], handle) -> None:
-    """In the fork: the client's streams as this process's, the job, its status."""
-    signal.signal(signal.SIGCHLD, signal.SIG_DFL)    # the job's own subprocesses
+    """In the job's fork: the client's streams as this process's, the job, its status."""
     os.dup2(fds[0], 1)
     os.dup2(fds[1], 2)
     for fd in fds:
         os.close(fd)
-    conn.sendall(_STARTED)
 
     def watch():                     # the client gone (Snakemake killed the job): stop
         if not conn.recv(1):
@@ -160,7 +207,7 @@ def serve(path: str, preload, prepare, handle, parent: int) -> None:
                     continue
                 if os.fork() == 0:
                     listener.close()
-                    _child(conn, argv, fds, handle)
+                    _watch(conn, argv, fds, handle)
                 for fd in fds:
                     os.close(fd)
     finally:
@@ -168,16 +215,19 @@ def serve(path: str, preload, prepare, handle, parent: int) -> None:
         Path(path).unlink(missing_ok=True)
 
 
-def start(env: str, config_file: str | Path, log: str | Path, wait_s: float = 10.0) -> str:
-    """Start a server for the jobs of ``config_file`` (its output to ``log``), and
-    name its socket in this process's environment variable ``env``, which the jobs
-    inherit. Returns the socket's path once the server listens on it."""
+def start(env: str, jobs: str, args: list[str], log: str | Path,
+          wait_s: float = 10.0) -> str:
+    """Start a server (its output to ``log``) for the jobs that ``jobs``, a function
+    named ``"module:function"``, sets up when called with ``args`` in the server's
+    process: it returns the three steps of :func:`serve`, ``(preload, prepare,
+    handle)``. Name the server's socket in this process's environment variable ``env``,
+    which the jobs inherit. Returns the socket's path once the server listens on it."""
     path = os.path.join(tempfile.mkdtemp(prefix="alfa-bench-"), "detect.sock")
     Path(log).parent.mkdir(parents=True, exist_ok=True)
     with open(log, "w") as out:
         _SERVERS[path] = subprocess.Popen(
-            [sys.executable, "-m", "alfa_bench.workflow.forkserver", path, str(config_file),
-             str(os.getpid())], stdout=out, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+            [sys.executable, "-m", "alfa_bench.workflow.forkserver", path, str(os.getpid()),
+             jobs, *map(str, args)], stdout=out, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
             env={**os.environ, **_ONE_THREAD})
     deadline = time.monotonic() + wait_s
     while not os.path.exists(path) and time.monotonic() < deadline:
@@ -200,21 +250,10 @@ def stop(env: str) -> None:
         del _SERVERS[path]
 
 
-def _main(path: str, config_file: str, parent: str) -> None:
-    from . import detect_job
-
-    def preload():
-        detect_job.preload(json.loads(Path(config_file).read_text()))
-
-    def prepare(argv):
-        if detect_job.code_changed():
-            print("a module changed since the server loaded it: jobs run on their own",
-                  file=sys.stderr)
-            return False
-        detect_job.prepare(detect_job.parse(argv))
-        return True
-
-    serve(path, preload, prepare, detect_job.forked, int(parent))
+def _main(path: str, parent: str, jobs: str, *args: str) -> None:
+    module, _, function = jobs.partition(":")
+    preload, prepare, handle = getattr(importlib.import_module(module), function)(*args)
+    serve(path, preload, prepare, handle, int(parent))
 
 
 if __name__ == "__main__":
