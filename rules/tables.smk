@@ -1,8 +1,10 @@
-# the run ends on one line naming the flights it could not score on, when there are any
+# the run ends on a line naming the flights it could not score on, when there are any,
+# and one naming the page to open; printed at exit, since Snakemake logs its own closing
+# lines (the log's path, the time taken) after this block
 onsuccess:
     forkserver.stop(SERVER_ENV)
-    if _failed := failed_flights_line():
-        logger.warning(_failed)
+    if _closing := closing_lines(PRIMARY):
+        atexit.register(print, *_closing, sep="\n", file=sys.stderr, flush=True)
 
 
 rule tables:

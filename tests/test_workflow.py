@@ -706,13 +706,16 @@ def test_every_run_scores_the_same_flights_and_every_output_names_those_left_out
     for flight in left_out.loc[left_out["subsets"].str.contains("no_emr"), "flight"]:
         assert flight in page and flight in paper
     assert "| excluded |" in (work / "results/tables/summary.md").read_text()
-    # last but Snakemake's own closing lines (the log's path, the time taken)
-    last = [line for line in done.stderr.strip().splitlines()[-3:]
-            if line.startswith("alfa-bench: ")]
-    assert last == [
+    # last, after Snakemake's own closing lines (the log's path, the time taken): then
+    # the page to open, with the runs it ranks and those it does not
+    headline = comparison[comparison["subset"] == "no_emr"]
+    ranked = int(headline["rank"].notna().sum())
+    assert done.stderr.strip().splitlines()[-2:] == [
         f"alfa-bench: {len(refused)} flight(s) left out of the common ground every run is "
         f"ranked on: {len(refused)} refused at load, 0 failed by 0 run(s); {len(failures)} "
-        "error(s) in results/tables/failures.csv, the flights in results/tables/left_out.csv"
+        "error(s) in results/tables/failures.csv, the flights in results/tables/left_out.csv",
+        f"alfa-bench: open results/index.html: {ranked} run(s) ranked on `no_emr`, "
+        f"{len(headline) - ranked} not ranked (each with why, on the page)",
     ], done.stderr
 
 
