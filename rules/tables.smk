@@ -57,6 +57,7 @@ rule index_page:
         comparison="results/tables/comparison.csv",
         by_fault="results/tables/by_fault.csv",
         left_out="results/tables/left_out.csv",
+        ceiling="results/tables/ceiling.csv",
         sweep="results/figures/sweep.png",
     output:
         "results/index.html",
