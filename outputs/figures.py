@@ -29,7 +29,7 @@ from alfa_bench.analysis.blocks import FAULT_ORDER  # noqa: E402
 from alfa_bench.analysis.detectability import EMPTY, by_fault, fault_name  # noqa: E402
 from alfa_bench.render import fmt  # noqa: E402
 
-__all__ = ["BLOCK_STYLES", "DPI", "SWEEP_LEGEND", "colors", "deadline_figure",
+__all__ = ["BLOCK_STYLES", "DPI", "SWEEP_LEGEND", "SWEEP_SIZE", "colors", "deadline_figure",
            "detectability_figure", "detection_time_figure", "save", "sweep_figure",
            "sweep_legend"]
 
@@ -59,22 +59,26 @@ def save(fig, path: str | Path) -> None:
 
 def sweep_figure(sweep: pd.DataFrame, subset: str, path: str | Path) -> None:
     """Three panels over the threshold scale, for ``subset`` of ``sweep``
-    (:func:`~.sweep.sweep_table`). Each curve is traced in the order of the scale; it
-    need not be monotone, since a lower threshold can turn a detection into an alarm
-    before onset."""
+    (:func:`~.sweep.sweep_table`), two by two with the legend in the fourth cell: drawn
+    at the size the results page shows it, so that its text reads there unscaled. Each
+    curve is traced in the order of the scale; it need not be monotone, since a lower
+    threshold can turn a detection into an alarm before onset."""
     data = sweep[sweep["subset"] == subset]
     methods = list(dict.fromkeys(data["method"]))
     shown = sweep_legend(data)
     palette = colors(shown)
     deadline = float(data["deadline_s"].iloc[0]) if len(data) else float("nan")
-    fig, axes = plt.subplots(1, 3, figsize=(15, 5.0), layout="constrained")
+    with plt.rc_context({"font.size": 8, "axes.labelsize": 8, "xtick.labelsize": 7,
+                         "ytick.labelsize": 7}):
+        fig, grid = plt.subplots(2, 2, figsize=SWEEP_SIZE, layout="constrained")
+    axes, key = [grid[0, 0], grid[0, 1], grid[1, 0]], grid[1, 1]
     panels = [
-        ("false_alarm_flights", "recall", "flights with a false alarm (share)",
-         f"detected within {deadline:g} s (recall)", "linear"),
-        ("false_alarms_per_hour", "recall", "false alarms per hour of fault-free flight",
-         f"detected within {deadline:g} s (recall)", "symlog"),
+        ("false_alarm_flights", "recall", "fault-free flights alarmed (share)",
+         f"detected ≤{deadline:g} s (recall)", "linear"),
+        ("false_alarms_per_hour", "recall", "false alarms per hour, fault-free",
+         f"detected ≤{deadline:g} s (recall)", "symlog"),
         ("false_alarms_per_hour", "mean_detection_s",
-         "false alarms per hour of fault-free flight", "mean detection time (s)", "symlog"),
+         "false alarms per hour, fault-free", "mean detection time (s)", "symlog"),
     ]
     for ax, (x, y, xlabel, ylabel, xscale) in zip(axes, panels, strict=True):
         # the runs outside the legend first, grey, under the best few
@@ -88,11 +92,12 @@ def sweep_figure(sweep: pd.DataFrame, subset: str, path: str | Path) -> None:
                     **({**BLOCK_STYLES[d["block"].iloc[0]], "lw": 0.8} if not named
                        else BLOCK_STYLES[d["block"].iloc[0]]))
             at = d[d["scale"] == 1.0]
-            ax.plot(at[x], at[y], "o", color=color, ms=6 if named else 4,
+            ax.plot(at[x], at[y], "o", color=color, ms=5 if named else 3,
                     mec="black" if named else "0.6", mew=0.6)
         ax.set_xscale(xscale, **({"linthresh": 1.0} if xscale == "symlog" else {}))
-        ax.set_xlabel(xlabel)
-        ax.set_ylabel(ylabel)
+        ax.set_xlabel(xlabel, fontsize=8)
+        ax.set_ylabel(ylabel, fontsize=8)
+        ax.tick_params(labelsize=7)
         ax.grid(alpha=0.3)
     axes[0].set_xlim(-0.02, 1.02)
     axes[0].set_ylim(-0.02, 1.02)
@@ -101,12 +106,17 @@ def sweep_figure(sweep: pd.DataFrame, subset: str, path: str | Path) -> None:
         axes[0].plot([], [], color="0.75", lw=0.8,
                      label=f"{len(methods) - len(shown)} other runs (grey)")
     handles, labels = axes[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside lower center", ncol=min(4, len(labels)),
-               fontsize=9)
+    key.axis("off")
     n = int(data["flights"].iloc[0]) if len(data) else 0
-    fig.suptitle(f"Threshold sweep, subset '{subset}' ({n} flights): every channel "
-                 "threshold scaled by one factor; dots = configured thresholds")
+    key.legend(handles, labels, loc="center", fontsize=7, frameon=False,
+               title=f"subset '{subset}', {n} flights;\nevery channel threshold scaled\n"
+                     "by one factor; dots: as configured", title_fontsize=7)
     save(fig, path)
+
+
+#: the sweep figure's size in inches: at :data:`DPI`, the width of the results page's
+#: figure column (outputs/index_page.py), so the page shows it unscaled
+SWEEP_SIZE = (5.6, 3.9)
 
 
 #: the runs the sweep's legend names: the best honest ones at the configured thresholds

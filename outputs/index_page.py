@@ -1,10 +1,13 @@
 """The page a reader opens first: ``results/index.html``.
 
 One light page, no external assets (the figure is inlined), that shows on arrival what
-the run found: the ranked honest runs on the headline subset, with their detections
-in time beside the stable ones and false alarms on fault-free flights; the threshold
-sweep figure; and each of those runs' detections by fault class. It links to the full
-tables, the per-flight outcomes and the Snakemake report.
+the run found: how many ranked runs the data cannot tell apart from the leader; the
+ranked honest runs on the headline subset, with their detections in time beside the
+stable ones and false alarms on fault-free flights; the threshold sweep figure; and
+each of those runs' detections by fault class, with the detectability ceiling of a
+class none of them detects. Below: the runs not ranked, each with why. It links to
+the full tables and the per-flight outcomes, every link a file ``snakemake all``
+writes.
 """
 
 from __future__ import annotations
@@ -23,8 +26,8 @@ from .tables import SIGNIFICANCE, SILENT, SUBSET_NOTES, ground_note
 
 __all__ = ["index_html"]
 
-#: laid out to show the headline, the per-class table and the figure in a 1400 x 900
-#: window without a scroll
+#: laid out to show the headline, the per-class table and the figure, at its own size
+#: (outputs/figures.py draws it for this column), in a 1400 x 900 window without a scroll
 _STYLE = """
 body { font: 14px/1.35 system-ui, sans-serif; margin: 14px 28px; color: #222;
        max-width: 1340px; }
@@ -33,8 +36,11 @@ p { margin: 2px 0 6px; } table { border-collapse: collapse; font-size: 13px; }
 th, td { padding: 1px 8px; border-bottom: 1px solid #ddd; text-align: right; }
 td { white-space: nowrap; }
 th { background: #f3f3f3; } td:nth-child(2), th:nth-child(2) { text-align: left; }
-.row { display: flex; gap: 28px; align-items: flex-start; }
-img { max-height: 330px; max-width: 100%; border: 1px solid #eee; }
+.row { display: flex; gap: 16px; align-items: flex-start; }
+.row > div:first-child { flex: 1 1 0; } .row > div:last-child { flex: none; width: min-content; }
+.row img { max-width: none; }
+img { max-width: 100%; border: 1px solid #eee; }
+.lead { font-size: 15px; margin: 4px 0 6px; }
 .links a { margin-right: 14px; } .note { color: #555; font-size: 12px; }
 """
 
@@ -72,12 +78,71 @@ def _told_apart(r: dict) -> str:
 
 
 def _apart(table: pd.DataFrame) -> str:
-    """How many ranked runs the data cannot tell apart from the leader (exact McNemar)."""
+    """The leader, and how many ranked runs the data cannot tell apart from it (exact
+    McNemar), in plain words for the top of the page."""
     if not len(table):
-        return ""
+        return "No run is ranked."
+    lead = table.iloc[0]
     same = int(((table["rank"] > 1) & (table["vs_best_p"] >= SIGNIFICANCE)).sum())
-    return (f" The data cannot tell the leader apart from {same} of the other "
-            f"{len(table) - 1} ranked runs (exact McNemar, p ≥ {SIGNIFICANCE}).")
+    found = f"{int(lead['tp'])} of {int(lead['tp'] + lead['fn'])} faults in time"
+    if not same:
+        return (f"The leader, <code>{html.escape(lead['method'])}</code> ({found}), is "
+                f"told apart from every other ranked run (exact McNemar, p &lt; "
+                f"{SIGNIFICANCE}).")
+    return (f"<strong>No clear winner:</strong> the data cannot tell the leader, "
+            f"<code>{html.escape(lead['method'])}</code> ({found}), apart from {same} of "
+            f"the other {len(table) - 1} ranked runs (exact McNemar, p ≥ {SIGNIFICANCE}).")
+
+
+#: why a run of each block is not ranked, when its row gives no reason of its own
+_WHY = {"reads actuators": "reads what the fault emulation writes (servo outputs, "
+                           "throttle), so it sees the label",
+        "reference": "a reference row: what lateness, the emulation alone or a "
+                     "calibration that saw the scored date gives"}
+
+
+def _unranked(subset: pd.DataFrame) -> str:
+    """The runs of the headline subset without a rank, each with why, in a list."""
+    rows = subset[subset["rank"].isna()]
+    if not len(rows):
+        return ""
+    items = []
+    for r in rows.to_dict(orient="records"):
+        why = r.get("not_ranked")
+        why = why if isinstance(why, str) and why else _WHY.get(r["block"], r["block"])
+        items.append(f"<li><code>{html.escape(r['method'])}</code>: {html.escape(why)}</li>")
+    return (f"<h2>Not ranked ({len(rows)} runs)</h2>\n<ul class=\"note\">"
+            + "".join(items) + "</ul>")
+
+
+def _beyond_reach(ceiling: pd.DataFrame, per_class: pd.DataFrame, shown, primary: str,
+                  d: str) -> str:
+    """For each fault class none of the ``shown`` runs detects in time, what the best
+    single feature of the ceiling table reaches on it, in a note."""
+    mine = per_class[per_class["method"].isin(shown)]
+    missed = [c for c, g in mine.groupby("fault_class", sort=False)
+              if c in FAULT_ORDER and c != "none" and g["flights"].gt(0).all()
+              and not g["detected"].any()]
+    best = ceiling[(ceiling["subset"] == primary) & ceiling["best"].astype(bool)
+                   ].drop_duplicates("fault_class").set_index("fault_class")
+    lines = []
+    for c in missed:
+        if c not in best.index:
+            continue
+        r = best.loc[c]
+        lines.append(
+            f"<code>{html.escape(c)}</code>: no single feature carries it within {d} s of "
+            f"onset: the best, <code>{html.escape(r['feature'])}</code>, separates its "
+            f"{int(r['fault_flights'])} flight{'s' * int(r['fault_flights'] > 1)} from "
+            f"fault-free flight with AUC "
+            f"{fmt(r['auc'])} (95 % {fmt(r['auc_low'])}-{fmt(r['auc_high'])}; 0.5 is "
+            f"chance) and passes every fault-free maximum on {int(r['above_free_max'])} of "
+            f"{int(r['fault_flights'])}")
+    if not lines:
+        return ""
+    return ('<p class="note">Why no run above detects these in time ('
+            '<a href="tables/ceiling.md">the detectability ceiling</a>): '
+            + "; ".join(lines) + ".</p>")
 
 
 def _left_out(left_out: pd.DataFrame, subset: str) -> str:
@@ -95,9 +160,10 @@ def _left_out(left_out: pd.DataFrame, subset: str) -> str:
 
 
 def index_html(comparison: pd.DataFrame, by_fault: pd.DataFrame, sweep_png: Path,
-               primary: str, run: str, left_out: pd.DataFrame) -> str:
-    """The page (module docstring) from the run's ``comparison``, ``by_fault`` and
-    ``left_out`` tables and its sweep figure; ``run`` names the run in the footer."""
+               primary: str, run: str, left_out: pd.DataFrame, ceiling: pd.DataFrame) -> str:
+    """The page (module docstring) from the run's ``comparison``, ``by_fault``,
+    ``left_out`` and ``ceiling`` tables and its sweep figure; ``run`` names the run in
+    the footer."""
     subset = comparison[comparison["subset"] == primary]
     table = subset[subset["rank"].notna()].sort_values("rank")
     d = fmt(float(comparison["deadline_s"].iloc[0]), digits=1)
@@ -132,28 +198,29 @@ def index_html(comparison: pd.DataFrame, by_fault: pd.DataFrame, sweep_png: Path
         _row([str(int(r["rank"])), r["method"], *(counts.get((r["method"], c), "-")
                                                   for c in present)])
         for r in table.head(CLASS_ROWS).to_dict(orient="records")]
+    reach = _beyond_reach(ceiling, per_class, table.head(CLASS_ROWS)["method"], primary, d)
     figure = base64.b64encode(Path(sweep_png).read_bytes()).decode()
     note = f"; {html.escape(SUBSET_NOTES[primary])}" if primary in SUBSET_NOTES else ""
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>alfa-bench: results</title>
 <style>{_STYLE}</style></head><body>
 <h1>alfa-bench: online fault detectors on the ALFA flights</h1>
-<p>Headline: subset <code>{html.escape(primary)}</code> ({flights}{note}).
-A fault counts as detected when the first alarm comes at most {d} s after its onset.
-Only honest runs (sensors and setpoints only) are ranked: by accuracy within the deadline
-(faults detected in time and fault-free flights left quiet, of all flights), then
-recall, then mean detection time.{quiet} A detection is <em>stable</em> when it
-survives when the calibration flights are resampled (most of the resamples; "not
-resampled": thresholds that need a refit).{_apart(table)}</p>
+<p class="lead">{_apart(table)}</p>
+<p>Headline: subset <code>{html.escape(primary)}</code> ({flights}{note}), a fault
+detected when the first alarm comes at most {d} s after onset; {len(table)} honest runs
+ranked, {int(subset["rank"].isna().sum())} not ranked (below, with why).</p>
 {_left_out(left_out, primary)}
 <p class="links"><a href="tables/comparison.html">every run and subset</a>
 <a href="tables/stability.md">stability</a> <a href="tables/per_flight.md">per flight</a>
-<a href="../paper/build/paper.md">the paper</a> <a href="report.html">the Snakemake report</a></p>
+<a href="tables/ceiling.md">detectability ceiling</a>
+<a href="../paper/build/paper.md">the paper</a> <span class="note">(the Snakemake
+report: <code>snakemake --report results/report.html</code>)</span></p>
 <h2>Ranked honest runs, deadline {d} s{shown}</h2>
 <table>{''.join(rows)}</table>
 <div class="row"><div>
 <h2>Faults detected in time, by class (the best {CLASS_ROWS})</h2>
 <table>{''.join(class_rows)}</table>
+{reach}
 <h2>The best run of each family</h2>
 <table>{''.join(family_rows)}</table></div>
 <div><h2>Threshold sweep</h2>
@@ -162,6 +229,13 @@ resampled": thresholds that need a refit).{_apart(table)}</p>
 <p class="note">Every channel threshold of a method scaled by one factor and the stored
 scores re-scored, on <code>{html.escape(primary)}</code> with the deadline; dots mark
 the configured thresholds.</p></div></div>
+<h2>How the runs are ranked</h2>
+<p>Only honest runs (sensors and setpoints only) are ranked: by accuracy within the
+deadline (faults detected in time and fault-free flights left quiet, of all flights),
+then recall, then mean detection time.{quiet} A detection is <em>stable</em> when it
+survives when the calibration flights are resampled (most of the resamples; "not
+resampled": thresholds that need a refit).</p>
+{_unranked(subset)}
 <p class="note">Run {html.escape(run)}: code, packages, config, data and checksums in
 <code>results/provenance.json</code>.</p>
 </body></html>

@@ -1,3 +1,4 @@
+import atexit
 import functools
 import os
 import shlex
@@ -11,7 +12,7 @@ from alfa_bench.workflow.preflight import alfa_dir_problem, failure_message, sto
 from alfa_bench.workflow import forkserver
 from alfa_bench.workflow.dependencies import module_sources, script_sources
 from alfa_bench.workflow.detect_job import SERVER_ENV, write_job_config
-from alfa_bench.workflow.logs import failed_flights_line
+from alfa_bench.workflow.logs import closing_lines
 from alfa_bench.workflow.stale import remove, stale_results
 from alfa_bench.workflow.resources import count_flights, job_resources
 from alfa_bench.outputs.provenance import RUN_FILE

@@ -1,8 +1,10 @@
-# the run ends on one line naming the flights it could not score on, when there are any
+# the run ends on a line naming the flights it could not score on, when there are any,
+# and one naming the page to open; printed at exit, since Snakemake logs its own closing
+# lines (the log's path, the time taken) after this block
 onsuccess:
     forkserver.stop(SERVER_ENV)
-    if _failed := failed_flights_line():
-        logger.warning(_failed)
+    if _closing := closing_lines(PRIMARY):
+        atexit.register(print, *_closing, sep="\n", file=sys.stderr, flush=True)
 
 
 rule tables:
@@ -56,6 +58,7 @@ rule index_page:
         comparison="results/tables/comparison.csv",
         by_fault="results/tables/by_fault.csv",
         left_out="results/tables/left_out.csv",
+        ceiling="results/tables/ceiling.csv",
         sweep="results/figures/sweep.png",
         code=script_code("index_page"),
     output:

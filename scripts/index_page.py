@@ -13,4 +13,5 @@ log_to(sm.log[0])
 prov = run_provenance(sm.config, read_manifest(sm.input.manifest))
 Path(sm.output[0]).write_text(index_html(
     read_table(sm.input.comparison), read_table(sm.input.by_fault), Path(sm.input.sweep),
-    sm.params.primary, run_id(prov), read_table(sm.input.left_out)))
+    sm.params.primary, run_id(prov), read_table(sm.input.left_out),
+    read_table(sm.input.ceiling)))

@@ -47,3 +47,30 @@ def test_the_python_guide_lists_every_signal_with_its_unit_topic_and_honesty():
         cells = [c.strip() for c in rows[name].split("|")[1:-1]]
         assert cells[1] == signal.unit and f"`{signal.topic}`" in cells[2], name
         assert cells[4].startswith("**no**") == (signal.kind == "actuator"), name
+
+
+def _slug(heading: str) -> str:
+    """A Markdown heading's anchor, as GitHub makes it."""
+    return re.sub(r"[^\w\- ]", "", heading.strip().lower()).replace(" ", "-")
+
+
+def test_every_anchor_names_a_heading():
+    missing = []
+    for doc in DOCS:
+        for target, anchor in re.findall(r"\]\(([^)#\s]*\.md)#([^)\s]+)\)", doc.read_text()):
+            text = (doc.parent / target).read_text()
+            slugs = {_slug(h) for h in re.findall(r"^#+ (.+)$", text, re.M)}
+            if anchor not in slugs:
+                missing.append(f"{doc.relative_to(REPO)} -> {target}#{anchor}")
+    assert not missing, missing
+
+
+def test_the_test_times_live_in_benchmarks():
+    """How long the test tiers take changes with every test added: the guide points to
+    BENCHMARKS.md, where it is measured and dated, instead of quoting it."""
+    guide = (REPO / "docs/development.md").read_text()
+    assert not re.findall(r"\b\d+ (?:s|tests)\b", guide)
+    assert "../BENCHMARKS.md#the-test-tiers" in guide
+    tiers = (REPO / "BENCHMARKS.md").read_text().split("## The test tiers\n")[1].split("\n## ")[0]
+    assert re.search(r'\| fast \| `pytest -m "not workflow and not slow"` \| \d{4}-\d\d-\d\d.*'
+                     r"\| \d+ s \| \d+ passed \|", tiers), tiers

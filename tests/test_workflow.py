@@ -25,6 +25,7 @@ from workflow_runs import GRID, REPO, SNAKEMAKE, assert_same_results, run_workfl
 
 from alfa_bench.data.synthetic import write_flight
 from alfa_bench.methods import REGISTRY
+from alfa_bench.outputs.figures import DPI, SWEEP_SIZE
 from alfa_bench.outputs.provenance import RUN_FILE, read_provenance, read_table
 from alfa_bench.outputs.records import INJECTED_RECORDS, RUN_RECORD, iter_records, read_run_record
 from alfa_bench.outputs.traces import read_trace
@@ -204,6 +205,30 @@ def test_the_results_page_opens_on_the_headline(runs):
     assert by_class.split("\t")[:2] == ["1", best["method"]], view
     assert view.images and min(view.images) > 100 and not view.errors, view
     assert view.images_in_view == len(view.images) and view.page_width <= 1400, view
+    # the figure is drawn for its column: shown at its own width, its text as drawn
+    assert view.images == [round(SWEEP_SIZE[0] * DPI)], view
+
+
+def test_the_results_page_says_who_is_really_ahead_and_every_link_resolves(runs):
+    """The tie with the leader in plain words at the top, every unranked run listed with
+    why, and every link and image of the page a file the run wrote."""
+    out = runs[0] / "results"
+    text = (out / "index.html").read_text()
+    comparison = read_table(out / "tables/comparison.csv")
+    rows = comparison[comparison["subset"] == "no_emr"]
+    ranked = rows[rows["rank"].notna()]
+    same = int(((ranked["rank"] > 1) & (ranked["vs_best_p"] >= 0.05)).sum())
+    lead = text.split('<p class="lead">')[1].split("</p>")[0]
+    assert (f"cannot tell the leader, <code>{ranked.sort_values('rank')['method'].iloc[0]}"
+            in lead) and f"apart from {same} of the other {len(ranked) - 1} ranked" in lead
+    unranked = text.split("<h2>Not ranked")[1]
+    for r in rows[rows["rank"].isna()].to_dict(orient="records"):
+        assert f"<li><code>{r['method']}</code>: " in unranked, r["method"]
+    links = re.findall(r'(?:href|src)="([^"]+)"', text)
+    assert {"tables/comparison.html", "tables/ceiling.md"} <= set(links)
+    missing = [u for u in links if not u.startswith("data:")
+               and not (out / u.split("#")[0]).is_file()]
+    assert not missing, missing
 
 
 def test_the_honest_benchmark_outputs(runs):
@@ -713,13 +738,16 @@ def test_every_run_scores_the_same_flights_and_every_output_names_those_left_out
     for flight in left_out.loc[left_out["subsets"].str.contains("no_emr"), "flight"]:
         assert flight in page and flight in paper
     assert "| excluded |" in (work / "results/tables/summary.md").read_text()
-    # last but Snakemake's own closing lines (the log's path, the time taken)
-    last = [line for line in done.stderr.strip().splitlines()[-3:]
-            if line.startswith("alfa-bench: ")]
-    assert last == [
+    # last, after Snakemake's own closing lines (the log's path, the time taken): then
+    # the page to open, with the runs it ranks and those it does not
+    headline = comparison[comparison["subset"] == "no_emr"]
+    ranked = int(headline["rank"].notna().sum())
+    assert done.stderr.strip().splitlines()[-2:] == [
         f"alfa-bench: {len(refused)} flight(s) left out of the common ground every run is "
         f"ranked on: {len(refused)} refused at load, 0 failed by 0 run(s); {len(failures)} "
-        "error(s) in results/tables/failures.csv, the flights in results/tables/left_out.csv"
+        "error(s) in results/tables/failures.csv, the flights in results/tables/left_out.csv",
+        f"alfa-bench: open results/index.html: {ranked} run(s) ranked on `no_emr`, "
+        f"{len(headline) - ranked} not ranked (each with why, on the page)",
     ], done.stderr
 
 

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pandas as pd
 
-__all__ = ["failed_flights_line", "log_to"]
+__all__ = ["closing_lines", "failed_flights_line", "log_to", "page_line"]
 
 
 def log_to(path: str) -> None:
@@ -40,3 +40,25 @@ def failed_flights_line(results: str | Path = "results") -> str | None:
     return (f"alfa-bench: {len(rows)} flight(s) left out of the common ground every run is "
             f"ranked on: {int(load.sum())} refused at load, {int((~load).sum())} failed by "
             f"{len(runs)} run(s); {errors} error(s) in {failures}, the flights in {left_out}")
+
+
+def page_line(primary: str, results: str | Path = "results") -> str | None:
+    """One line naming the page to open, ``results/index.html``, with how many runs the
+    comparison ranks on the headline subset ``primary`` and how many it leaves unranked;
+    None when the run wrote no page."""
+    results = Path(results)
+    page, comparison = results / "index.html", results / "tables/comparison.csv"
+    if not page.is_file() or not comparison.is_file():
+        return None
+    rows = pd.read_csv(comparison, usecols=["subset", "rank"])
+    rows = rows[rows["subset"] == primary]
+    ranked = int(rows["rank"].notna().sum())
+    return (f"alfa-bench: open {page}: {ranked} run(s) ranked on `{primary}`, "
+            f"{len(rows) - ranked} not ranked (each with why, on the page)")
+
+
+def closing_lines(primary: str, results: str | Path = "results") -> list[str]:
+    """The lines a successful run ends on: the flights it failed on, if any, then the
+    page to open (:func:`failed_flights_line`, :func:`page_line`)."""
+    return [line for line in (failed_flights_line(results), page_line(primary, results))
+            if line]
