@@ -155,7 +155,7 @@ def _left_out(left_out: pd.DataFrame, subset: str) -> str:
         + ("refused at load" if r["runs"] == "every run" else
            f"failed by {html.escape(str(r['runs']).replace(';', ', '))}")
         for r in rows.to_dict(orient="records"))
-    return (f'<p class="note">Every run is ranked on the flights every run scored; left '
+    return (f'<p class="note">The runs are ranked on the flights every ranked run scored; left '
             f'out: {why} (why: <a href="tables/failures.csv">failures.csv</a>).</p>')
 
 

@@ -9,7 +9,7 @@ run did not produce.
 
 Keys (``<m>`` a method run, ``<s>`` a subset, ``<sig>`` a catalogue signal, ``<c>`` a
 fault class): ``deadline`` (s), ``flights:<s>`` (the subset's flights on the common
-ground, the flights every run scored), ``ground:<s>`` (the subset's size and, where a
+ground, the flights every ranked run scored), ``ground:<s>`` (the subset's size and, where a
 flight was left out, its common ground: "26 flights, 22 on the common ground, 4 left
 out"), ``leftout`` (the flights left out and why, or "none"), ``faultfree:<s>``,
 ``faultflights:<s>``;
