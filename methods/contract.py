@@ -392,7 +392,8 @@ def check_many_continued_runs_equal_each_run(detector: Detector) -> None:
         _expect(sorted(continued) == sorted(o.id for o in others),
                 f"a run of each flight {sorted(o.id for o in others)}", sorted(continued))
         for other in others:
-            np.testing.assert_allclose(continued[other.id][1], run_detector(d, other).score,
+            np.testing.assert_allclose(run_detector(d, other, continued=continued[other.id]).score,
+                                       run_detector(d, other).score,
                                        rtol=1e-9, atol=1e-9,
                                        err_msg=f"run_many()'s scores of {other.id} differ "
                                                "from its run's")

@@ -32,7 +32,8 @@ def test_a_builtin_detector_depends_on_its_modules_and_imports_none():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           check=True)
     assert done.stdout.strip() == str(["alfa_bench.methods.base",
-                                       "alfa_bench.methods.extremes"]), done.stdout
+                                       "alfa_bench.methods.extremes",
+                                       "alfa_bench.methods.unmoved"]), done.stdout
 
 
 def test_a_plugin_package_is_followed_into_its_own_modules(tmp_path, monkeypatch):
