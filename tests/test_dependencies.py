@@ -2,7 +2,6 @@
 modules read, not imported, and a plugin's own modules followed as the project's are;
 a script's modules too, so that a changed module re-runs the aggregates that use it."""
 
-import os
 import re
 import shutil
 import subprocess
@@ -10,7 +9,7 @@ import sys
 import textwrap
 
 import pytest
-from workflow_runs import REPO, SNAKEMAKE
+from workflow_runs import REPO, dry_run_with_changed
 
 from alfa_bench.methods import detector_module
 from alfa_bench.workflow.dependencies import module_sources, script_sources
@@ -78,18 +77,7 @@ def test_a_changed_module_reruns_the_jobs_that_import_it_and_those_after(runs, o
                                                                          module):
     """A dry run over the reference run, with ``module``'s text changed by one comment
     line (Snakemake compares small inputs by content) and restored byte for byte."""
-    path = REPO / module
-    text, stat = path.read_bytes(), path.stat()
-    try:
-        path.write_bytes(text + b"# changed by test_dependencies\n")
-        env = {k: v for k, v in os.environ.items() if k != "ALFA_DIR"}
-        done = subprocess.run([*SNAKEMAKE, "all", "-n", "--cores", "2", "--snakefile",
-                               str(REPO / "Snakefile"), "--directory", str(runs[1]),
-                               "--configfile", str(REPO / "config/config.yaml"),
-                               str(overlay[0])], env=env, capture_output=True, text=True)
-    finally:
-        path.write_bytes(text)
-        os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns))
+    done = dry_run_with_changed(REPO / module, runs[1], overlay[0], "test_dependencies")
     assert done.returncode == 0, done.stdout + done.stderr
     planned = set(re.findall(r"^(?:local)?rule (\w+):$", done.stdout, re.MULTILINE))
     assert planned == AFTER_A_CHANGE[module], done.stdout

@@ -21,7 +21,14 @@ from broken import (
     topic_file,
 )
 from unavailable import unavailable
-from workflow_runs import GRID, REPO, SNAKEMAKE, assert_same_results, run_workflow
+from workflow_runs import (
+    GRID,
+    REPO,
+    SNAKEMAKE,
+    assert_same_results,
+    dry_run_with_changed,
+    run_workflow,
+)
 
 from alfa_bench.data.synthetic import write_flight
 from alfa_bench.methods import REGISTRY
@@ -309,18 +316,8 @@ def test_a_changed_method_module_reruns_exactly_its_jobs(runs, overlay):
     (methods/windows.py, methods/extremes.py) but not its module. (Snakemake compares small
     inputs by content, so the module's text changes, by one comment line, and is
     restored byte for byte.)"""
-    module = REPO / "methods/residual_bank.py"
-    text, stat = module.read_bytes(), module.stat()
-    try:
-        module.write_bytes(text + b"# changed by test_workflow\n")
-        env = {k: v for k, v in os.environ.items() if k != "ALFA_DIR"}
-        done = subprocess.run([*SNAKEMAKE, "all", "-n", "--cores", "2", "--snakefile",
-                               str(REPO / "Snakefile"), "--directory", str(runs[1]),
-                               "--configfile", str(REPO / "config/config.yaml"),
-                               str(overlay[0])], env=env, capture_output=True, text=True)
-    finally:
-        module.write_bytes(text)
-        os.utime(module, ns=(stat.st_atime_ns, stat.st_mtime_ns))
+    done = dry_run_with_changed(REPO / "methods/residual_bank.py", runs[1], overlay[0],
+                                "test_workflow")
     jobs = re.findall(r"rule (\w+):\n(?:    .*\n)*?    wildcards: method=(\w+)", done.stdout)
     assert sorted(jobs) == [("detect", m) for m in ("bench_logistic", "bench_logistic_no_emr",
                                                     "learned_fusion", "residual_bank",

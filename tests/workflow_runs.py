@@ -36,6 +36,24 @@ def run_workflow(workdir: Path, alfa_dir: Path | None, *args: str,
     return done
 
 
+def dry_run_with_changed(module: Path, workdir: Path, overlay: Path, tag: str
+                          ) -> subprocess.CompletedProcess:
+    """``snakemake all -n`` over the run in ``workdir`` with ``module``'s text changed by
+    one comment line (Snakemake compares small inputs by content), restored byte for
+    byte, its times too, whatever the run did."""
+    text, stat = module.read_bytes(), module.stat()
+    try:
+        module.write_bytes(text + f"# changed by {tag}\n".encode())
+        env = {k: v for k, v in os.environ.items() if k != "ALFA_DIR"}
+        return subprocess.run([*SNAKEMAKE, "all", "-n", "--cores", "2", "--snakefile",
+                               str(REPO / "Snakefile"), "--directory", str(workdir),
+                               "--configfile", str(REPO / "config/config.yaml"),
+                               str(overlay)], env=env, capture_output=True, text=True)
+    finally:
+        module.write_bytes(text)
+        os.utime(module, ns=(stat.st_atime_ns, stat.st_mtime_ns))
+
+
 def assert_same_results(a: Path, b: Path, part: bool = False) -> int:
     """Every result of run ``b`` is run ``a``'s, byte for byte, but the rerun recordings:
     rerun 0.41 draws its ids from the clock and orders its footer index by a hash map
