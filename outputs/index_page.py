@@ -83,6 +83,11 @@ def _apart(table: pd.DataFrame) -> str:
     if not len(table):
         return "No run is ranked."
     lead = table.iloc[0]
+    if not int(lead["tp"] + lead["fn"]):
+        # a ranking of runs that had no fault to find says nothing of which finds faults
+        return (f"<strong>No run can be told ahead:</strong> the {int(lead['flights'])} "
+                "flight(s) every ranked run scored hold no fault, so the ranks below "
+                "order false alarms alone.")
     same = int(((table["rank"] > 1) & (table["vs_best_p"] >= SIGNIFICANCE)).sum())
     found = f"{int(lead['tp'])} of {int(lead['tp'] + lead['fn'])} faults in time"
     if not same:

@@ -2,7 +2,7 @@
 
 import pandas as pd
 
-from alfa_bench.outputs.index_page import _beyond_reach
+from alfa_bench.outputs.index_page import _apart, _beyond_reach
 
 
 def test_a_class_no_shown_run_detects_is_explained_by_the_ceiling():
@@ -25,3 +25,16 @@ def test_a_class_no_shown_run_detects_is_explained_by_the_ceiling():
             "fault-free maximum on 0 of 5") in note
     assert "engine" not in note and 'href="tables/ceiling.md"' in note
     assert _beyond_reach(ceiling, per_class, ["a", "c"], "no_emr", "5.0") == ""
+
+
+def test_a_ranking_on_flights_without_a_fault_names_no_leader():
+    """Where the flights every ranked run scored hold no fault (a small corpus whose
+    runs failed elsewhere), the top line says no run can be told ahead, not that the
+    data cannot tell a 'leader' of 0 of 0 faults apart from the others."""
+    table = pd.DataFrame({"method": ["a", "b"], "rank": [1, 2], "tp": [0, 0],
+                          "fn": [0, 0], "flights": [1, 1], "vs_best_p": [None, 1.0]})
+    line = _apart(table)
+    assert "No run can be told ahead" in line and "1 flight(s)" in line
+    assert "leader" not in line
+    table[["tp", "fn"]] = [[3, 1], [1, 3]]
+    assert "leader, <code>a</code> (3 of 4 faults in time)" in _apart(table)
