@@ -57,6 +57,7 @@ import hashlib
 import inspect
 import logging
 import math
+import types
 from abc import ABC, abstractmethod
 from collections import deque
 from dataclasses import dataclass, field
@@ -205,9 +206,9 @@ def json_ready(value):
 
 def source_digest(cls: type, package: bool = False) -> str:
     """A digest of the code of ``cls`` and of its bases outside alfa-bench (with
-    ``package``, alfa-bench's own too): the source where it can be read, else each
-    function's bytecode and constants (a class typed into a notebook; a sealed fit's
-    own, :func:`_sealed`)."""
+    ``package``, alfa-bench's own too): the source where it can be read, else its
+    compiled code (a class typed into a notebook or run as ``__main__``:
+    :func:`_compiled`), the same in every process."""
     skipped = ("builtins", "abc") if package else ("alfa_bench", "builtins", "abc")
     h = hashlib.blake2b(digest_size=16)
     for c in cls.__mro__:
@@ -216,11 +217,50 @@ def source_digest(cls: type, package: bool = False) -> str:
         try:
             h.update(inspect.getsource(c).encode())
         except (OSError, TypeError):
-            for name, f in sorted(vars(c).items()):
-                code = getattr(getattr(f, "__wrapped__", f), "__code__", None)
-                if code is not None:
-                    h.update(name.encode() + code.co_code + repr(code.co_consts).encode())
+            h.update(_compiled(c))
     return h.hexdigest()
+
+
+def _compiled(cls: type) -> bytes:
+    """What ``cls`` runs, without its source: each function's code (a sealed fit's own,
+    :func:`_sealed`; a property's accessors) and each attribute of plain data, by
+    name."""
+    out = []
+    for name, value in sorted(vars(cls).items()):
+        value = getattr(value, "__func__", value)            # classmethod, staticmethod
+        functions = ([value.fget, value.fset, value.fdel] if isinstance(value, property)
+                     else [value])
+        codes = [getattr(getattr(f, "__wrapped__", f), "__code__", None) for f in functions]
+        if any(c is not None for c in codes):
+            out += [name.encode(), *(_stable(c) for c in codes)]
+        elif _plain_constant(value):
+            out += [name.encode(), _stable(value)]
+    return b"\0".join(out)
+
+
+def _plain_constant(value) -> bool:
+    if isinstance(value, tuple | frozenset):
+        return all(map(_plain_constant, value))
+    return value is None or isinstance(value, str | bytes | int | float | complex)
+
+
+def _stable(value) -> bytes:
+    """``value`` (a code object, or one of its constants) as bytes that are the same in
+    every process: a nested function's code by its content, not by its ``repr`` (which
+    holds its address), and a set's items in sorted order (not the order of the
+    process's string hashes)."""
+    if isinstance(value, types.CodeType):
+        fields = (value.co_argcount, value.co_posonlyargcount, value.co_kwonlyargcount,
+                  value.co_flags, value.co_names, value.co_varnames, value.co_freevars,
+                  value.co_cellvars)
+        return b"code(" + b"\0".join([value.co_code, value.co_exceptiontable,
+                                       repr(fields).encode(),
+                                       *map(_stable, value.co_consts)]) + b")"
+    if isinstance(value, frozenset | set):
+        return b"set(" + b"\0".join(sorted(map(_stable, value))) + b")"
+    if isinstance(value, tuple):
+        return b"tuple(" + b"\0".join(map(_stable, value)) + b")"
+    return f"{type(value).__name__}:{value!r}".encode()
 
 
 def clone(detector: Detector) -> Detector:

@@ -31,6 +31,10 @@ warning, naming it, and in what :func:`load_model` returns (``code_changed``): i
 loads, since its state is the one saved, but what it scores may differ. The digests
 are in the file: they catch a damaged file or an edit that did not recompute them,
 not a forger; what holds against any file is that loading runs none of its code.
+
+The encoding (:func:`encode`, :func:`decode`) and the checked archive
+(:func:`write_archive`, :func:`read_archive`) also hold the fits kept on disk
+(:mod:`.fits`).
 """
 
 from __future__ import annotations
@@ -52,7 +56,8 @@ from alfa_bench.data import reads_actuators
 
 from .base import Detector, fit_token, learned_digest, learned_state, source_digest
 
-__all__ = ["FORMAT", "FORMAT_VERSION", "ModelFileError", "load_model", "save_model"]
+__all__ = ["FORMAT", "FORMAT_VERSION", "ModelFileError", "decode", "encode", "load_model",
+           "read_archive", "save_model", "write_archive"]
 
 log = logging.getLogger(__name__)
 
@@ -73,13 +78,16 @@ def _version() -> str:
     return __version__
 
 
-def _encode(value, arrays: list[np.ndarray], where: str):
+def encode(value, arrays: list[np.ndarray], where: str):
+    """``value`` as JSON-ready data (module docstring), its numeric arrays appended to
+    ``arrays`` and named by their index; raises :class:`ModelFileError` naming
+    ``where`` in it for what cannot be saved as arrays and JSON."""
     from . import detector_name
 
     if isinstance(value, Detector):
-        return {"detector": detector_name(value), "params": _encode(value.get_params(), arrays,
+        return {"detector": detector_name(value), "params": encode(value.get_params(), arrays,
                                                                     f"{where}.params"),
-                "state": _encode(learned_state(value), arrays, f"{where}.state"),
+                "state": encode(learned_state(value), arrays, f"{where}.state"),
                 "source": source_digest(type(value), package=True)}
     if isinstance(value, np.ndarray | np.generic):
         a = np.asarray(value)
@@ -92,26 +100,27 @@ def _encode(value, arrays: list[np.ndarray], where: str):
     if isinstance(value, float):
         return value if math.isfinite(value) else {"float": repr(value)}
     if isinstance(value, list):
-        return [_encode(v, arrays, f"{where}[{i}]") for i, v in enumerate(value)]
+        return [encode(v, arrays, f"{where}[{i}]") for i, v in enumerate(value)]
     if isinstance(value, tuple):
-        return {"tuple": [_encode(v, arrays, f"{where}[{i}]") for i, v in enumerate(value)]}
+        return {"tuple": [encode(v, arrays, f"{where}[{i}]") for i, v in enumerate(value)]}
     if isinstance(value, deque):
-        return {"deque": [_encode(v, arrays, f"{where}[{i}]") for i, v in enumerate(value)],
+        return {"deque": [encode(v, arrays, f"{where}[{i}]") for i, v in enumerate(value)],
                 "maxlen": value.maxlen}
     if isinstance(value, dict):
         if all(isinstance(k, str) for k in value):
-            return {"dict": {k: _encode(v, arrays, f"{where}.{k}") for k, v in value.items()}}
-        return {"pairs": [[_encode(k, arrays, f"{where} key"),
-                           _encode(v, arrays, f"{where}[{k!r}]")] for k, v in value.items()]}
+            return {"dict": {k: encode(v, arrays, f"{where}.{k}") for k, v in value.items()}}
+        return {"pairs": [[encode(k, arrays, f"{where} key"),
+                           encode(v, arrays, f"{where}[{k!r}]")] for k, v in value.items()]}
     raise ModelFileError(f"{where}: a {type(value).__name__} cannot be saved as arrays and "
                          "JSON")
 
 
-def _decode(value, arrays: dict[str, np.ndarray], changed: list[str]):
-    """``value`` as :func:`_encode` wrote it, decoded; the name of each detector built
-    whose code is not the code saved is appended to ``changed``."""
+def decode(value, arrays: dict[str, np.ndarray], changed: list[str]):
+    """``value`` as :func:`encode` wrote it (its arrays named ``a<i>``), decoded; the
+    name of each detector built whose code is not the code saved is appended to
+    ``changed``."""
     if isinstance(value, list):
-        return [_decode(v, arrays, changed) for v in value]
+        return [decode(v, arrays, changed) for v in value]
     if not isinstance(value, dict):
         return value
     if "array" in value:
@@ -120,14 +129,14 @@ def _decode(value, arrays: dict[str, np.ndarray], changed: list[str]):
     if "float" in value:
         return float(value["float"])
     if "tuple" in value:
-        return tuple(_decode(v, arrays, changed) for v in value["tuple"])
+        return tuple(decode(v, arrays, changed) for v in value["tuple"])
     if "deque" in value:
-        return deque((_decode(v, arrays, changed) for v in value["deque"]),
+        return deque((decode(v, arrays, changed) for v in value["deque"]),
                      maxlen=value["maxlen"])
     if "dict" in value:
-        return {k: _decode(v, arrays, changed) for k, v in value["dict"].items()}
+        return {k: decode(v, arrays, changed) for k, v in value["dict"].items()}
     if "pairs" in value:
-        return {_decode(k, arrays, changed): _decode(v, arrays, changed)
+        return {decode(k, arrays, changed): decode(v, arrays, changed)
                 for k, v in value["pairs"]}
     if "detector" in value:
         return _build(value, arrays, changed)
@@ -137,14 +146,60 @@ def _decode(value, arrays: dict[str, np.ndarray], changed: list[str]):
 def _build(spec: dict, arrays: dict[str, np.ndarray], changed: list[str]) -> Detector:
     from . import make_detector
 
-    detector = make_detector(spec["detector"], _decode(spec["params"], arrays, changed))
+    detector = make_detector(spec["detector"], decode(spec["params"], arrays, changed))
     if spec.get("source") != source_digest(type(detector), package=True):
         changed.append(spec["detector"])
-    for name, v in _decode(spec["state"], arrays, changed).items():
+    for name, v in decode(spec["state"], arrays, changed).items():
         if not name.endswith("_") or name.startswith("_"):
             raise ValueError(f"{name!r} is not a learned attribute")
         setattr(detector, name, v)
     return detector
+
+
+def write_archive(path: str | os.PathLike, body: dict, arrays: list[np.ndarray]) -> Path:
+    """Write ``body`` (JSON-ready, as :func:`encode` gives) and the ``arrays`` it refers
+    to as an archive at ``path``: ``model.json``, ``a0``, ``a1``, ... and the SHA-256
+    over them (``sha256``), as :func:`numpy.savez_compressed` writes them but dated
+    1980-01-01, so that the same content is the same bytes."""
+    # keys in their order: a restored state must be set in the order the fit set it
+    document = json.dumps(body, allow_nan=False).encode()
+    named = {f"a{i}": a for i, a in enumerate(arrays)}
+    digest = _digest(document, named)
+    path = Path(path)
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
+        for name, a in {**named, "model.json": np.frombuffer(document, np.uint8),
+                        "sha256": np.frombuffer(digest.encode(), np.uint8)}.items():
+            member = zipfile.ZipInfo(f"{name}.npy", date_time=(1980, 1, 1, 0, 0, 0))
+            member.compress_type = zipfile.ZIP_DEFLATED
+            with archive.open(member, "w", force_zip64=True) as f:
+                np.lib.format.write_array(f, np.asanyarray(a), allow_pickle=False)
+    path.write_bytes(buffer.getvalue())
+    return path
+
+
+def read_archive(path: str | os.PathLike) -> tuple[dict, dict[str, np.ndarray]]:
+    """The document and the arrays (``a<i>``) of the archive at ``path``
+    (:func:`write_archive`), read without pickle and checked against their SHA-256.
+
+    Raises
+    ------
+    ModelFileError
+        Naming the file: unreadable, not such an archive, or damaged or altered."""
+    try:
+        with np.load(path, allow_pickle=False) as archive:
+            arrays = {name: archive[name] for name in archive.files}
+    except (OSError, ValueError, zipfile.BadZipFile, EOFError, zlib.error) as e:
+        raise ModelFileError(f"{path}: not a readable model file ({e})") from None
+    try:
+        document = arrays.pop("model.json").tobytes()
+        saved = arrays.pop("sha256").tobytes().decode()
+    except (KeyError, UnicodeDecodeError):
+        raise ModelFileError(f"{path}: not an alfa-bench model file") from None
+    if _digest(document, arrays) != saved:
+        raise ModelFileError(f"{path}: its content does not match its SHA-256: the file is "
+                             "damaged or was edited")
+    return json.loads(document), arrays
 
 
 def _digest(document: bytes, arrays: dict[str, np.ndarray]) -> str:
@@ -171,17 +226,8 @@ def save_model(detector: Detector, path: str | os.PathLike, *, run: str,
             "signals": list(detector.signals()), "rate_hz": detector.rate_hz,
             "reads_actuators": reads_actuators(detector.signals()),
             "fit_token": fit_token(detector),
-            "model": _encode(detector, arrays, type(detector).__name__)}
-    # keys in their order: a restored state must be set in the order the fit set it
-    document = json.dumps(body, allow_nan=False).encode()
-    named = {f"a{i}": a for i, a in enumerate(arrays)}
-    digest = _digest(document, named)
-    path = Path(path)
-    buffer = io.BytesIO()
-    np.savez_compressed(buffer, **named, **{"model.json": np.frombuffer(document, np.uint8),
-                                             "sha256": np.frombuffer(digest.encode(), np.uint8)})
-    path.write_bytes(buffer.getvalue())
-    return path
+            "model": encode(detector, arrays, type(detector).__name__)}
+    return write_archive(path, body, arrays)
 
 
 def load_model(path: str | os.PathLike) -> tuple[Detector, dict]:
@@ -198,20 +244,7 @@ def load_model(path: str | os.PathLike) -> tuple[Detector, dict]:
         format or package version, of a detector this installation does not know, or a
         state that does not give the saved fit."""
     path = Path(path)
-    try:
-        with np.load(path, allow_pickle=False) as archive:
-            arrays = {name: archive[name] for name in archive.files}
-    except (OSError, ValueError, zipfile.BadZipFile, EOFError, zlib.error) as e:
-        raise ModelFileError(f"{path}: not a readable model file ({e})") from None
-    try:
-        document = arrays.pop("model.json").tobytes()
-        saved = arrays.pop("sha256").tobytes().decode()
-    except (KeyError, UnicodeDecodeError):
-        raise ModelFileError(f"{path}: not an alfa-bench model file") from None
-    if _digest(document, arrays) != saved:
-        raise ModelFileError(f"{path}: its content does not match its SHA-256: the file is "
-                             "damaged or was edited")
-    body = json.loads(document)
+    body, arrays = read_archive(path)
     if body.get("format") != FORMAT or body.get("format_version") != FORMAT_VERSION:
         raise ModelFileError(f"{path}: format {body.get('format')!r} version "
                              f"{body.get('format_version')!r}; this reads {FORMAT!r} "

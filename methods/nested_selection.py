@@ -76,8 +76,9 @@ log = logging.getLogger(__name__)
 #: :class:`~.base.CalibrationError` it could not be fitted with), by the candidate's
 #: code and hyper-parameters and its data (:func:`~.fits.fit_key`): the 256 last used,
 #: twice the distinct inner fits of the workflow's largest run (12 candidates, each
-#: without every pair of ALFA's 5 dates)
-INNER_FITS = KeptFits(256)
+#: without every pair of ALFA's 5 dates); and in the folder :func:`~.fits.use_files`
+#: names, where the fit is arrays and JSON
+INNER_FITS = KeptFits(256, "inner")
 
 
 def _sharing(made: list[Detector]) -> list[list[int]]:
