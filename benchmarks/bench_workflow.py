@@ -19,10 +19,18 @@
 - ``--methods-of DIR``, ``--targets RULE ...``: keep only the method runs of another
   checkout's config, and run these rules instead of ``all``, so that two commits with
   different runs and products can be timed on the same work.
+- ``--stored``: the run over the flights once, then ``results/`` removed but for the
+  fits the detect jobs keep (``results/fits``) and ``snakemake all`` again: both wall
+  times, the fits' size, and the second run's cost table.
+- ``--costs DIR``: only print the cost table of the workflow run in ``DIR`` (its
+  ``results/benchmarks/detect``), running nothing.
 
 Each case runs in a fresh temporary working directory; prints a Markdown table of wall
 times, then the wall time and peak resident memory of each job of each run from empty
-that keeps a Snakemake benchmark file.
+that keeps a Snakemake benchmark file, and the cost table of each: per run, the fits
+made, kept in the job, and read from ``results/fits``, and the seconds spent fitting,
+scoring, on features, reading and writing (``workflow/job_costs.py`` says what each
+counts).
 """
 
 from __future__ import annotations
@@ -32,6 +40,7 @@ import copy
 import csv
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -97,6 +106,34 @@ def job_stats(work: Path) -> dict[str, tuple[float, float]]:
     return out
 
 
+def cost_table(work: Path) -> str:
+    """The cost table of the workflow run in ``work``: a Markdown row per detect job,
+    longest first, from the columns the job writes beside its time, and their sum."""
+    from alfa_bench.workflow.job_costs import COLUMNS
+
+    rows = []
+    for tsv in sorted((work / "results/benchmarks/detect").glob("*.tsv")):
+        with tsv.open() as f:
+            row = next(csv.DictReader(f, delimiter="\t"))
+        # NaN: a job of a commit before the costs were written
+        rows.append((tsv.stem, float(row["s"]), [float(row.get(c, "nan")) for c in COLUMNS]))
+    rows.sort(key=lambda r: -r[1])
+    total = ("all", sum(r[1] for r in rows),
+             [sum(r[2][i] for r in rows) for i in range(len(COLUMNS))])
+    head = ["run", "wall s", *(c.removesuffix("_s").replace("_", " ") + (" s" if c.endswith(
+        "_s") else "") for c in COLUMNS)]
+    lines = ["| " + " | ".join(head) + " |", "|---" * len(head) + "|"]
+    for name, wall, values in [*rows, total]:
+        cells = [f"{v:.0f}" if not c.endswith("_s") else f"{v:.2f}"
+                 for c, v in zip(COLUMNS, values, strict=True)]
+        lines.append(f"| {name} | {wall:.2f} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def _size_mb(folder: Path) -> float:
+    return sum(f.stat().st_size for f in folder.rglob("*") if f.is_file()) / 1e6
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--flights", type=int, nargs="*", default=[1, 2, 4])
@@ -108,14 +145,20 @@ def main() -> None:
                     help="keep only the method runs of this checkout's config")
     ap.add_argument("--targets", nargs="+", default=["all"],
                     help="the rules to run instead of all")
+    ap.add_argument("--stored", action="store_true",
+                    help="run again with results/ removed but for the fits kept")
+    ap.add_argument("--costs", type=Path, help="only print the cost table of this run")
     args = ap.parse_args()
+    if args.costs:
+        print(cost_table(args.costs))
+        return
     root = args.root.resolve()
     processed = Path(os.environ["ALFA_DIR"]) / "processed"
     base = yaml.safe_load((root / "config/config.yaml").read_text())
     if args.methods_of:
         keep = yaml.safe_load((args.methods_of / "config/config.yaml").read_text())["methods"]
         base["methods"] = {m: s for m, s in base["methods"].items() if m in keep}
-    memory = {}
+    memory, costs = {}, {}
     print("| case | flights found | method runs | wall s |")
     print("|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
@@ -129,6 +172,7 @@ def main() -> None:
             n = replicate(processed, alfa / "processed", k, args.extra)
             wall, _ = run(root, alfa, config, tmp / f"flights{k}", args.targets)
             memory[f"flights x{k}"] = job_stats(tmp / f"flights{k}")
+            costs[f"flights x{k}"] = cost_table(tmp / f"flights{k}")
             print(f"| flights x{k} | {n} | {len(base['methods'])} | {wall:.1f} |", flush=True)
         for k in args.settings:
             swept = dict(base)
@@ -146,6 +190,7 @@ def main() -> None:
             config.write_text(yaml.safe_dump(base))
             wall, _ = run(root, once, config, tmp / "changed", args.targets)
             memory["all, from empty"] = job_stats(tmp / "changed")
+            costs["all, from empty"] = cost_table(tmp / "changed")
             print(f"| all, before the change | {found} | {len(base['methods'])} | {wall:.1f} |")
             size = {}
             for f in (tmp / "changed/results").rglob("*"):
@@ -161,11 +206,28 @@ def main() -> None:
             ran = ", ".join(f"{rule} {k}" for rule, k in sorted(jobs.items()))
             print(f"| all, after glrt_arx_chi2 changed ({ran}) | {found} | "
                   f"{len(base['methods'])} | {wall:.1f} |", flush=True)
+        if args.stored:
+            config = tmp / "stored.yaml"
+            config.write_text(yaml.safe_dump(base))
+            work = tmp / "stored"
+            wall, _ = run(root, once, config, work, args.targets)
+            print(f"| all, from empty | {found} | {len(base['methods'])} | {wall:.1f} |")
+            costs["all, from empty"] = cost_table(work)
+            for part in (work / "results").iterdir():
+                if part.name != "fits":
+                    shutil.rmtree(part) if part.is_dir() else part.unlink()
+            stored = _size_mb(work / "results/fits")
+            wall, _ = run(root, once, config, work, args.targets)
+            print(f"| all, results/ removed but its fits ({stored:.0f} MB) | {found} | "
+                  f"{len(base['methods'])} | {wall:.1f} |", flush=True)
+            costs["all, with the fits kept"] = cost_table(work)
     if args.changed:
         print(f"\n{sizes}")
     for case, stats in memory.items():
         print(f"\nJobs of {case}: wall s, peak resident MB")
         print("\n".join(f"- {job}: {s:.2f} s, {mb:.0f} MB" for job, (s, mb) in stats.items()))
+    for case, table in costs.items():
+        print(f"\nCosts of {case}:\n{table}")
 
 
 if __name__ == "__main__":

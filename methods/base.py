@@ -204,11 +204,14 @@ def json_ready(value):
     return repr(value)
 
 
+@functools.cache
 def source_digest(cls: type, package: bool = False) -> str:
     """A digest of the code of ``cls`` and of its bases outside alfa-bench (with
     ``package``, alfa-bench's own too): the source where it can be read, else its
     compiled code (a class typed into a notebook or run as ``__main__``:
-    :func:`_compiled`), the same in every process."""
+    :func:`_compiled`), the same in every process. Read once per class (finding a
+    class's source parses its module): a class object runs the code it was made
+    from, whatever its file says later."""
     skipped = ("builtins", "abc") if package else ("alfa_bench", "builtins", "abc")
     h = hashlib.blake2b(digest_size=16)
     for c in cls.__mro__:

@@ -58,6 +58,7 @@ import weakref
 from collections import Counter, OrderedDict
 from collections.abc import Iterator
 from contextlib import contextmanager
+from importlib import metadata
 from pathlib import Path
 
 import numpy as np
@@ -153,15 +154,12 @@ def _modules_digest(module: str) -> str | None:
 @functools.cache
 def _versions() -> dict[str, str]:
     """What else a fit may depend on: the versions of the package, Python and the
-    numerical libraries."""
-    import scipy
-    import sklearn
-
+    numerical libraries (as installed: importing one costs more than a fit)."""
     from alfa_bench import __version__
 
     return {"alfa-bench": __version__, "python": platform.python_version(),
-            "numpy": np.__version__, "scipy": scipy.__version__, "scikit-learn":
-            sklearn.__version__}
+            **{name: metadata.version(name) for name in ("numpy", "scipy", "scikit-learn",
+                                                         "numba")}}
 
 
 class FitFiles:

@@ -1,5 +1,10 @@
 import json
 
+# The fits the detect jobs share (methods/fits.py), across jobs, runs and re-runs, bounded
+# by the config's fits: max_mb. No rule's output: a fit read from it is the fit a job
+# would make, so no result depends on which fits it holds.
+FITS = "results/fits"
+
 
 # The reference rows (role: reference) on the real flights only: they speak of ALFA's
 # metric and emulation, not of sensors.
@@ -30,7 +35,7 @@ rule detect_reference:
     wildcard_constraints:
         method="|".join(REFERENCES),
     shell:
-        DETECT_JOB
+        DETECT_JOB + f" --fits {FITS}"
 
 
 # Every other run, on the real flights and on the injected sensor-fault grid in one job

@@ -1,7 +1,8 @@
 """Fits kept on disk (methods/fits.py: FitFiles, use_files): a fit read back is the fit a
 fresh fit makes; a file of another key, of other code or damaged is refused; two
 writers leave one whole file; the folder stays within its bound; the contract's refit
-check never reads it; a notebook class's code digest is the same in every process."""
+check never reads it; a notebook class's code digest is the same in every process; a
+detect job run again reads its fits and writes the same records, and its costs."""
 
 import json
 import os
@@ -16,6 +17,8 @@ from alfa_bench.methods import base, fits, labelled_segments, make_detector
 from alfa_bench.methods.bench_logistic import BenchLogistic
 from alfa_bench.methods.model_files import read_archive, write_archive
 from alfa_bench.methods.nested_selection import INNER_FITS
+from alfa_bench.workflow.detect_job import BENCHMARK_COLUMNS, SERVER_ENV
+from alfa_bench.workflow.job_costs import COLUMNS
 
 
 @pytest.fixture
@@ -237,3 +240,50 @@ def test_a_key_names_its_document():
     key = fits.FitKey({"module": "m", "params": {"a": (1, 2)}})
     assert key == fits.FitKey(json.loads(json.dumps(key.document)))
     assert key != fits.FitKey({"module": "m", "params": {"a": [1, 3]}})
+
+
+def _job(work, run: str, out, fits_folder) -> dict:
+    """The detect job of ``run`` over the workflow run in ``work``'s flights, alone in
+    its process, writing to ``out``: its benchmark row."""
+    config = next((work / ".snakemake/alfa-bench").glob("config-*.json"))
+    out.mkdir(parents=True)
+    paths = {a: out / a for a in ("detections", "traces", "panels")}
+    subprocess.run([sys.executable, "-m", "alfa_bench.workflow.detect_job", run,
+                    "--manifest", str(work / "results/flights.csv"),
+                    "--cache", str(work / "results/cache"), "--config", str(config),
+                    *(f"--{a}={p}" for a, p in paths.items()),
+                    "--benchmark", str(out / "job.tsv"), "--log", str(out / "job.log"),
+                    "--fits", str(fits_folder)],
+                   check=True, env={k: v for k, v in os.environ.items() if k != SERVER_ENV})
+    names, values = (line.split("\t") for line in (out / "job.tsv").read_text().splitlines())
+    return dict(zip(names, values, strict=True))
+
+
+@pytest.mark.workflow
+def test_a_jobs_rerun_reads_its_fits_and_writes_the_same_records_and_costs(runs, tmp_path):
+    """The workflow's job keeps its fits in the folder it is given; the job again, in a
+    new process, reads them instead of fitting, and writes the records the workflow
+    wrote. Its benchmark keeps Snakemake's columns, then the cost table's."""
+    work, folder = runs[0], tmp_path / "fits"
+    assert list((work / "results/fits").glob("inner-*.npz"))     # the workflow's own
+    first = _job(work, "residual_bank_nested", tmp_path / "first", folder)
+    again = _job(work, "residual_bank_nested", tmp_path / "again", folder)
+    assert list(first)[:4] == list(BENCHMARK_COLUMNS)
+    assert list(first)[4:] == list(COLUMNS)
+    assert int(first["fits_made"]) > int(again["fits_made"]) and int(again["fits_read"]) > 0
+    assert int(first["fits_read"]) == 0 and float(first["fitting_s"]) > 0
+    assert all(float(first[c]) > 0 for c in ("scoring_s", "reading_s", "writing_s"))
+    assert "read from" in (tmp_path / "again/job.log").read_text()
+    for name in ("first", "again"):
+        made = tmp_path / name / "detections"
+        records = sorted(p.name for p in made.glob("*.json"))
+        assert records == sorted(p.name for p in (
+            work / "results/detections/residual_bank_nested").glob("*.json"))
+        for record in records:
+            assert _outcome(made / record) == _outcome(
+                work / "results/detections/residual_bank_nested" / record), record
+
+
+def _outcome(path) -> dict:
+    """A record but its provenance (which names the files it was written to)."""
+    return {k: v for k, v in json.loads(path.read_text()).items() if k != "provenance"}

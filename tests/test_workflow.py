@@ -278,7 +278,8 @@ def test_every_result_file_records_its_provenance(runs, corpus):
     # parsed-flight cache is keyed by them
     files = [p for p in (work / "results").rglob("*") if p.is_file()
              and not p.name.startswith(".snakemake")     # Snakemake's directory markers
-             and not {"logs", "benchmarks", "cache", "rerun_parts", "figure_parts"}
+             and not {"logs", "benchmarks", "cache", "rerun_parts", "figure_parts",
+                      "fits"}       # the fits the jobs share: model files, no result
              & set(p.relative_to(work).parts)
              and p not in (work / "results/injected/flights.csv", work / RUN_FILE)
              and p.name != RUN_RECORD]     # what the injected records share: read through them

@@ -2,7 +2,13 @@
 scored on it, over the injected sensor-fault grid, built in memory from the cached
 fault-free flights; each fold is fitted once, on real flights only. Writes the
 detection records, traces, the run's panel of each flight's figure, the flights it
-had to exclude, and the job's own time (``results/benchmarks/detect/<run>.tsv``).
+had to exclude, and the job's own time and costs (``results/benchmarks/detect/<run>.tsv``:
+Snakemake's benchmark columns, then :data:`~.job_costs.COLUMNS`).
+
+With ``--fits <folder>`` (the workflow gives ``results/fits``) the fits the detectors
+keep (:mod:`alfa_bench.methods.fits`) are read from and written to that folder too,
+bounded by the config's ``fits: max_mb``, so that the jobs of a run, later runs and
+re-runs share them.
 
 The rule's command is this module::
 
@@ -22,6 +28,7 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
+import logging
 import os
 import resource
 import sys
@@ -79,6 +86,8 @@ def parse(argv: list[str]) -> argparse.Namespace:
     p.add_argument("--injected", help="the injected grid's manifest")
     p.add_argument("--injected-out", help="where the injected records go")
     p.add_argument("--processed", help="the injected flights' folder name")
+    p.add_argument("--fits", help="the folder of fits the jobs share (the config's "
+                   "fits: max_mb bounds it); none: fits are kept in the job only")
     args = p.parse_args(argv)
     if args.config is None:
         p.error(f"the workflow's config: give --config, or set {CONFIG_ENV}")
@@ -155,17 +164,33 @@ def prepare(args: argparse.Namespace) -> tuple:
 def run(args: argparse.Namespace, started: float = _START) -> None:
     """The job: score ``args.method`` and write its files, then its time since
     ``started`` (:func:`time.perf_counter`; by default, this module's import)."""
+    from alfa_bench.methods import fits, make_detector
     from alfa_bench.outputs.records import write_detections
+    from alfa_bench.workflow.job_costs import measured
     from alfa_bench.workflow.logs import log_to
 
     log_to(args.log)
+    reading = time.perf_counter()
     config, manifest, flights, on_grid = prepare(args)
+    reading = time.perf_counter() - reading
     injected = None if on_grid is None else (on_grid, Path(args.injected_out))
-    write_detections(args.method, config["methods"][args.method], flights, manifest,
-                     dict(config["calibration"]), strict=config["strict"], config=config,
-                     out=Path(args.detections), traces=Path(args.traces),
-                     panels=Path(args.panels), injected=injected)
-    _write_benchmark(Path(args.benchmark), time.perf_counter() - started)
+    spec = config["methods"][args.method]
+    fits.use_files(args.fits and Path(args.fits), int(config["fits"]["max_mb"] * 1e6))
+    # the run's detector and those it builds, imported before their timers are set
+    detector = make_detector(spec["detector"], spec.get("params"))
+    detector.check_params()
+    with measured(type(detector)) as costs:
+        write_detections(args.method, spec, flights, manifest, dict(config["calibration"]),
+                         strict=config["strict"], config=config, out=Path(args.detections),
+                         traces=Path(args.traces), panels=Path(args.panels),
+                         injected=injected)
+    costs["reading_s"] += reading
+    if args.fits:
+        logging.getLogger(__name__).info(
+            "fits: %d made, %d kept, %d read from %s, %d refused there, %d kept in the job "
+            "only (not arrays and JSON)", costs["fits_made"], costs["fits_kept"],
+            costs["fits_read"], args.fits, fits.COUNTS["refused"], fits.COUNTS["unstorable"])
+    _write_benchmark(Path(args.benchmark), time.perf_counter() - started, costs)
 
 
 def server_jobs(config_file: str) -> tuple:
@@ -192,16 +217,19 @@ def forked(argv: list[str]) -> None:
     run(parse(argv), time.perf_counter())
 
 
-def _write_benchmark(path: Path, wall_s: float) -> None:
+def _write_benchmark(path: Path, wall_s: float, costs: dict) -> None:
     """The job's wall time from its start (its fork from the server, or its process's
     start when run alone), its CPU time and peak resident memory, MB, in Snakemake's
-    benchmark columns."""
+    benchmark columns; then its ``costs`` (:data:`~.job_costs.COLUMNS`)."""
     usage = resource.getrusage(resource.RUSAGE_SELF)
     cpu_s = usage.ru_utime + usage.ru_stime
     hms = time.strftime("%H:%M:%S", time.gmtime(wall_s))
+    names = list(costs)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text("\t".join(BENCHMARK_COLUMNS) + "\n"
-                    f"{wall_s:.4f}\t{hms}\t{usage.ru_maxrss / 1024:.2f}\t{cpu_s:.4f}\n")
+    path.write_text("\t".join([*BENCHMARK_COLUMNS, *names]) + "\n"
+                    f"{wall_s:.4f}\t{hms}\t{usage.ru_maxrss / 1024:.2f}\t{cpu_s:.4f}\t"
+                    + "\t".join(f"{costs[n]:.4f}" if isinstance(costs[n], float)
+                                else str(costs[n]) for n in names) + "\n")
 
 
 def main(argv: list[str] | None = None) -> int:
