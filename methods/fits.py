@@ -26,9 +26,9 @@ written there too (:class:`FitFiles`), so that the jobs of a run, later runs and
 re-runs share it: one file per fit, ``<store>-<key>.npz``, in the model-file format
 (:mod:`.model_files`: arrays and JSON, never pickle, a SHA-256 over all of it). The
 file holds its key's whole document, and what else a fit depends on outside the
-class: the source of every project module the class's module imports
-(:func:`~alfa_bench.workflow.dependencies.module_sources`: a helper edited elsewhere is
-another key) and the versions of the package, Python and the numerical libraries. A
+class: the source of every project module the class's module imports (the workflow
+names them: :func:`~alfa_bench.workflow.dependencies.module_sources`; a helper edited
+elsewhere is another key) and the versions of the package, Python and the numerical libraries. A
 file whose document differs in any part, or whose digest fails, is refused (logged,
 and fitted again). The folder is bounded (its total size): writing a fit evicts the
 least recently used (a read touches its file). Files are written whole (a temporary
@@ -56,7 +56,7 @@ import platform
 import time
 import weakref
 from collections import Counter, OrderedDict
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from importlib import metadata
 from pathlib import Path
@@ -135,23 +135,6 @@ def fit_key(detector: Detector, data, params: dict | None = None) -> FitKey | No
 
 
 @functools.cache
-def _modules_digest(module: str) -> str | None:
-    """A digest of the source of ``module`` and of every project module it imports
-    (read once per process, as :func:`code_of`); None for a module without a file (a
-    notebook's, ``__main__`` run from a string)."""
-    from alfa_bench.workflow.dependencies import module_sources
-
-    try:
-        sources = module_sources(module)
-    except (ImportError, ValueError, TypeError, OSError):   # found nowhere, or no file
-        return None
-    h = hashlib.sha256()
-    for path in sources:
-        h.update(path.rsplit("/", 1)[-1].encode() + b"\0" + Path(path).read_bytes())
-    return h.hexdigest()
-
-
-@functools.cache
 def _versions() -> dict[str, str]:
     """What else a fit may depend on: the versions of the package, Python and the
     numerical libraries (as installed: importing one costs more than a fit)."""
@@ -172,6 +155,10 @@ class FitFiles:
         Made when the first fit is written.
     max_bytes : int
         The bound on the folder's total size.
+    sources : callable
+        The source files a module's code runs on, by the module's name (the module's
+        own and those of the project's modules it imports): a fit's file records their
+        digest.
     """
 
     #: the format's name, in every file
@@ -179,11 +166,14 @@ class FitFiles:
     #: the version of what a file holds
     FORMAT_VERSION = 1
 
-    def __init__(self, folder: str | os.PathLike, max_bytes: int):
+    def __init__(self, folder: str | os.PathLike, max_bytes: int,
+                 sources: Callable[[str], list[str]]):
         self.folder = Path(folder)
         self.max_bytes = max_bytes
+        self.sources = sources
         #: the folder's size as last seen, plus what this process wrote since
         self._size: int | None = None
+        self._modules: dict[str, str | None] = {}
 
     def path(self, store: str, key: FitKey) -> Path:
         """The file of the fit under ``key`` in ``store``."""
@@ -194,11 +184,26 @@ class FitFiles:
         the key's document, the code of the project's modules it reads, the versions
         (:func:`_versions`); None where the class's module has no source to digest (not
         written then)."""
-        modules = _modules_digest(key.document["module"])
+        modules = self._modules_digest(key.document["module"])
         if modules is None:
             return None
         return json.loads(json.dumps({"store": store, "key": key.document,
                                       "modules": modules, "versions": _versions()}))
+
+    def _modules_digest(self, module: str) -> str | None:
+        """A digest of the :attr:`sources` of ``module`` (read once: a module runs the
+        code it was imported from); None for a module without a file (a notebook's,
+        ``__main__`` run from a string)."""
+        if module not in self._modules:
+            try:
+                paths = self.sources(module)
+            except (ImportError, ValueError, TypeError, OSError):   # no module file
+                paths = None
+            h = hashlib.sha256()
+            for path in paths or ():
+                h.update(Path(path).name.encode() + b"\0" + Path(path).read_bytes())
+            self._modules[module] = None if paths is None else h.hexdigest()
+        return self._modules[module]
 
     def read(self, store: str, key: FitKey):
         """The fit under ``key`` in ``store``, its file touched (now the last used); None
@@ -295,11 +300,15 @@ class FitFiles:
 _FILES: FitFiles | None = None
 
 
-def use_files(folder: str | os.PathLike | None, max_bytes: int = 0) -> None:
-    """Keep this process's fits in ``folder`` too (:class:`FitFiles`), bounded by
-    ``max_bytes``; None: in the process only."""
+def use_files(folder: str | os.PathLike | None, max_bytes: int = 0,
+              sources: Callable[[str], list[str]] | None = None) -> None:
+    """Keep this process's fits in ``folder`` too (:class:`FitFiles`, with
+    ``max_bytes`` and ``sources``, which it needs); None: in the process only."""
     global _FILES
-    _FILES = None if folder is None else FitFiles(folder, max_bytes)
+    if folder is not None and sources is None:
+        raise ValueError("use_files: a folder of fits needs the sources of the modules "
+                         "their code runs on")
+    _FILES = None if folder is None else FitFiles(folder, max_bytes, sources)
 
 
 class KeptFits:

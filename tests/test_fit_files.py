@@ -17,6 +17,7 @@ from alfa_bench.methods import base, fits, labelled_segments, make_detector
 from alfa_bench.methods.bench_logistic import BenchLogistic
 from alfa_bench.methods.model_files import read_archive, write_archive
 from alfa_bench.methods.nested_selection import INNER_FITS
+from alfa_bench.workflow.dependencies import module_sources
 from alfa_bench.workflow.detect_job import BENCHMARK_COLUMNS, SERVER_ENV
 from alfa_bench.workflow.job_costs import COLUMNS
 
@@ -24,7 +25,7 @@ from alfa_bench.workflow.job_costs import COLUMNS
 @pytest.fixture
 def folder(tmp_path):
     """The stores empty, their fits kept in ``tmp_path`` too; in the process only after."""
-    fits.use_files(tmp_path, 10**8)
+    fits.use_files(tmp_path, 10**8, module_sources)
     fits.MODEL_FITS.clear()
     INNER_FITS.clear()
     fits.COUNTS.clear()
@@ -167,7 +168,7 @@ def test_two_writers_leave_one_whole_file_and_the_bound_evicts_the_least_used(fo
     assert [p.name for p in folder.iterdir()] == [f"model-{keys[0]}.npz"]
     assert next(folder.iterdir()).read_bytes() == once       # the same bytes, undated
     size = next(folder.iterdir()).stat().st_size
-    fits.use_files(folder, int(2.5 * size))
+    fits.use_files(folder, int(2.5 * size), module_sources)
     store.put(keys[1], fit)
     first = fits._FILES.path("model", keys[0])
     os.utime(first, (1, 1))                           # long unused ...

@@ -166,6 +166,7 @@ def run(args: argparse.Namespace, started: float = _START) -> None:
     ``started`` (:func:`time.perf_counter`; by default, this module's import)."""
     from alfa_bench.methods import fits, make_detector
     from alfa_bench.outputs.records import write_detections
+    from alfa_bench.workflow.dependencies import module_sources
     from alfa_bench.workflow.job_costs import measured
     from alfa_bench.workflow.logs import log_to
 
@@ -175,7 +176,8 @@ def run(args: argparse.Namespace, started: float = _START) -> None:
     reading = time.perf_counter() - reading
     injected = None if on_grid is None else (on_grid, Path(args.injected_out))
     spec = config["methods"][args.method]
-    fits.use_files(args.fits and Path(args.fits), int(config["fits"]["max_mb"] * 1e6))
+    fits.use_files(args.fits and Path(args.fits), int(config["fits"]["max_mb"] * 1e6),
+                   module_sources)
     # the run's detector and those it builds, imported before their timers are set
     detector = make_detector(spec["detector"], spec.get("params"))
     detector.check_params()
