@@ -27,6 +27,7 @@ include: "rules/detect.smk"
 include: "rules/tables.smk"
 include: "rules/sweep.smk"
 include: "rules/rerun.smk"
+include: "rules/parts.smk"
 include: "rules/paper.smk"
 include: "rules/inject.smk"
 include: "rules/report.smk"
@@ -45,7 +46,8 @@ rule all:
         rules.runtime.output,
         rules.sweep.output,
         rules.flight_figures.output,
-        rules.rerun_logs.output,
+        rules.rerun_flights.output,
+        expand(rules.run_parts.output.recordings, method=METHODS),
         rules.paper_sources.output,
         rules.detectability.output,
         rules.isolation.output,

@@ -1,10 +1,15 @@
-"""One rerun recording per flight: signals, every method's scores and intermediates.
+"""The rerun recording of a flight: signals, every method's scores and intermediates.
 
-Open one with ``rerun results/rerun/<flight>.rrd``. Everything is on the
-``flight_time`` timeline (seconds on the flight clock); the recording id is the
-flight's name, and no wall-clock time is logged, so the same inputs give the same
-entities, times and values (rerun's own row and chunk ids are time-based, so the
-bytes differ between writes).
+The workflow writes it in parts, one file each, so that a changed run rewrites only its
+own: the flight's (:func:`write_flight_part`: signals, fault, properties, layout),
+``results/rerun/_flight/<flight>.rrd``, and each run's (:func:`write_run_part`),
+``results/rerun/<method>/<flight>.rrd``. The parts of a flight share its recording id,
+the flight's name, so the viewer opens them as one recording:
+``rerun results/rerun/*/<flight>.rrd``. :func:`write_rerun_log` writes the whole
+recording to one file. Everything is on the ``flight_time`` timeline (seconds on the
+flight clock) and no wall-clock time is logged, so the same inputs give the same
+entities, times and values (rerun's own row and chunk ids are time-based, so the bytes
+differ between writes).
 
 Entities
 --------
@@ -23,8 +28,8 @@ Entities
 ``events``
     Fault onset and end, and the start of every alarm of every method.
 Recording properties: ``flight`` (fault class, onset, end, date, label and the
-code version that wrote the file) and ``provenance`` (the run's provenance as JSON,
-:func:`~.provenance.read_provenance` reads it back).
+code version that wrote the file), in the flight's part, and ``provenance`` (as JSON,
+:func:`~.provenance.read_provenance` reads it back): each file carries its own.
 """
 
 from __future__ import annotations
@@ -42,7 +47,8 @@ from alfa_bench.analysis.sweep import ratio
 from alfa_bench.data import SIGNALS, AlfaDataError, Flight, series
 from alfa_bench.methods import Trace
 
-__all__ = ["TIMELINE", "blueprint", "signal_group", "write_rerun_log"]
+__all__ = ["TIMELINE", "blueprint", "signal_group", "write_flight_part", "write_rerun_log",
+           "write_run_part"]
 
 log = logging.getLogger(__name__)
 
@@ -166,13 +172,36 @@ def _method_entities(rec: rr.RecordingStream, method: str, tr: Trace) -> None:
     _series(rec, f"overview/{method}", tr.t, np.where(np.isinf(r), np.nan, r), method)
 
 
-def _recording(flight: Flight, methods: list[str], signals: list[str], path: Path,
-               provenance: dict, fill) -> None:
-    """The recording of ``flight`` at ``path``: its properties, blueprint (a tab per
-    method of ``methods``), raw ``signals`` and overview bars, then what ``fill(rec)``
-    logs of the methods, then the event log of ``fill``'s alarm events with the
-    fault's."""
+def _stream(flight_id: str, path: Path, provenance: dict,
+            layout: rrb.Blueprint | None = None) -> rr.RecordingStream:
+    """A stream to ``path`` of the recording of ``flight_id`` (its id: the files of one
+    flight open as one recording), carrying ``provenance`` and the ``layout``."""
     path.parent.mkdir(parents=True, exist_ok=True)
+    rec = rr.RecordingStream(_APPLICATION, recording_id=flight_id, send_properties=False)
+    rec.save(path)
+    if layout is not None:
+        # active, not only the default: a default is not taken up when another file of
+        # the recording, opened with it, had the viewer draw a layout of its own first
+        rec.send_blueprint(layout, make_active=True, make_default=True)
+    rec.send_property("provenance", rr.AnyValues(
+        json=json.dumps(provenance, sort_keys=True, allow_nan=False)))
+    return rec
+
+
+def _close(rec: rr.RecordingStream, events: list[tuple[float, str, str]]) -> None:
+    """Log ``events`` (time, text, level) in time order, and close the stream."""
+    if events:
+        times, texts, levels = zip(*sorted(events, key=lambda e: (e[0], e[1])), strict=True)
+        rec.send_columns("events", indexes=[rr.TimeColumn(TIMELINE, duration=list(times))],
+                         columns=rr.TextLog.columns(text=list(texts), level=list(levels)))
+    rec.flush()
+    rec.disconnect()
+
+
+def _flight_stream(flight: Flight, methods: list[str], signals: list[str], path: Path,
+                   provenance: dict) -> rr.RecordingStream:
+    """The stream of ``flight``'s own entities: its properties, blueprint (a tab per
+    method of ``methods``), raw ``signals`` and overview bars."""
     raw = {}
     for s in signals:
         try:
@@ -180,12 +209,11 @@ def _recording(flight: Flight, methods: list[str], signals: list[str], path: Pat
         except AlfaDataError as e:
             log.warning("%s: signal %s not recorded: %s", flight.id, s, e)
     groups = [g for g in _GROUPS if any(signal_group(s) == g for s in raw)]
-    rec = rr.RecordingStream(_APPLICATION, recording_id=flight.id, send_properties=False)
     fault = flight.fault
     span = (None if fault is None or fault.onset_s is None
             else (fault.onset_s, fault.end_s))
     title = f"{fault.fault_class if fault else 'unlabelled'}: {flight.id}"
-    rec.save(path, default_blueprint=blueprint(methods, groups, title, span))
+    rec = _stream(flight.id, path, provenance, blueprint(methods, groups, title, span))
     rec.send_recording_name(flight.id)
     rec.send_property("flight", rr.AnyValues(
         flight=flight.id, date=flight.date, label=flight.label,
@@ -193,35 +221,46 @@ def _recording(flight: Flight, methods: list[str], signals: list[str], path: Pat
         onset_s=np.nan if fault is None or fault.onset_s is None else fault.onset_s,
         fault_end_s=np.nan if fault is None or fault.end_s is None else fault.end_s,
         git_commit=code_version()["git_commit"] or "unknown"))
-    rec.send_property("provenance", rr.AnyValues(
-        json=json.dumps(provenance, sort_keys=True, allow_nan=False)))
-
     for s, (t, v) in raw.items():
         _series(rec, f"signals/{signal_group(s)}/{s}", t, v, s, step=True)
-    alarms = fill(rec)
     if span is not None:
         # a bar along the top of the overview from onset to the fault's end
         _series(rec, "overview/fault", np.array(span), np.full(2, 2.9), "fault", _RED)
     _series(rec, "overview/threshold", np.array([0.0, flight.duration_s]), np.ones(2),
             "alarm level", _RED)
-
-    events = sorted(_fault_events(flight) + alarms, key=lambda e: (e[0], e[1])) if fault else []
-    if events:
-        times, texts, levels = zip(*events, strict=True)
-        rec.send_columns("events", indexes=[rr.TimeColumn(TIMELINE, duration=list(times))],
-                         columns=rr.TextLog.columns(text=list(texts), level=list(levels)))
-    rec.flush()
-    rec.disconnect()
+    return rec
 
 
 def write_rerun_log(flight: Flight, traces: dict[str, Trace], signals: list[str],
                     path: str | Path, provenance: dict) -> None:
     """Write the recording of ``flight`` with the ``traces`` of each method (with
-    probes), the raw ``signals`` and the run's ``provenance`` to ``path``. A signal the
-    flight cannot give (a column a method excluded it for) is left out, and logged."""
-    def fill(rec):
-        for method, tr in traces.items():
-            _method_entities(rec, method, tr)
-        return [e for method, tr in traces.items() for e in _alarm_events(method, tr)]
+    probes), the raw ``signals`` and the run's ``provenance`` to ``path``, in one file.
+    A signal the flight cannot give (a column a method excluded it for) is left out,
+    and logged."""
+    rec = _flight_stream(flight, list(traces), signals, Path(path), provenance)
+    for method, tr in traces.items():
+        _method_entities(rec, method, tr)
+    # an unlabelled flight has no fault to set the alarms against: no event log
+    _close(rec, [] if flight.fault is None else _fault_events(flight) + [
+        e for method, tr in traces.items() for e in _alarm_events(method, tr)])
 
-    _recording(flight, list(traces), signals, Path(path), provenance, fill)
+
+def write_flight_part(flight: Flight, methods: list[str], signals: list[str],
+                      path: str | Path, provenance: dict) -> None:
+    """Write the part of ``flight``'s recording that no run's changes: its properties,
+    the raw ``signals``, the overview's fault bar and alarm level, the fault's events,
+    and the layout, a tab for each of ``methods``. :func:`write_run_part` writes each
+    run's part; rerun opens the files of one flight as one recording."""
+    rec = _flight_stream(flight, methods, signals, Path(path), provenance)
+    _close(rec, [] if flight.fault is None else _fault_events(flight))
+
+
+def write_run_part(flight_id: str, method: str, trace: Trace, path: str | Path,
+                   provenance: dict) -> None:
+    """Write ``method``'s part of the recording of flight ``flight_id`` to ``path``:
+    its entities from ``trace`` (scores, thresholds, intermediates, overview line) and
+    its alarms in the event log, with the run's ``provenance``; no layout, which the
+    flight's part (:func:`write_flight_part`) carries."""
+    rec = _stream(flight_id, Path(path), provenance)
+    _method_entities(rec, method, trace)
+    _close(rec, _alarm_events(method, trace))

@@ -88,6 +88,14 @@ def script_code(name):
 
 
 @functools.cache
+def recorded_signals():
+    """The raw signals the flights' parts record: every run's detector's, in config
+    order (a changed parameter of a run re-records no flight unless it changes them)."""
+    detectors = [make_detector(s["detector"], s.get("params")) for s in config["methods"].values()]
+    return list(dict.fromkeys(s for d in detectors for s in d.signals()))
+
+
+@functools.cache
 def _fault_classes():
     """Each flight's fault class, from the manifest, read once per report."""
     from alfa_bench.data import read_manifest

@@ -12,7 +12,7 @@ rule provenance:
         RUN_FILE,
     params:
         # differ between runs by nature: rerun's clock-drawn ids, measured times
-        unchecked=["results/rerun/*.rrd", "results/runtime/*"],
+        unchecked=["results/rerun/*/*.rrd", "results/runtime/*"],
     resources:
         **JOB_RESOURCES,
     log:

@@ -1,24 +1,26 @@
-rule rerun_logs:
-    # the longest jobs start first, and the short ones fill the other cores
-    priority: 2
+# The rerun recordings, one file per flight and part, which the viewer opens as one
+# recording per flight (`rerun results/rerun/*/<flight>.rrd`): each flight's own part
+# here, each run's in run_parts, so that a changed run rewrites only its own files.
+rule rerun_flights:
     input:
         manifest="results/flights.csv",
         cache="results/cache",
-        traces=expand("results/traces/{method}", method=METHODS),
-        code=script_code("rerun_logs"),
+        code=script_code("rerun_flights"),
     output:
-        directory("results/rerun"),
+        # not a run's name (those start with a letter): the flights' own parts
+        directory("results/rerun/_flight"),
     params:
-        # canonical JSON: reordered keys are not a change (the tab order follows input)
-        methods=json.dumps(config["methods"], sort_keys=True),
+        # the layout's tabs, one per run in config order, and the signals recorded
+        runs=METHODS,
+        signals=lambda w: recorded_signals(),
     resources:
         **JOB_RESOURCES,
     log:
-        "results/logs/rerun_logs.log",
+        "results/logs/rerun_flights.log",
     benchmark:
-        "results/benchmarks/rerun_logs.tsv"
+        "results/benchmarks/rerun_flights.tsv"
     script:
-        "../scripts/rerun_logs.py"
+        "../scripts/rerun_flights.py"
 
 
 # The README's picture of a recording in rerun's web viewer, taken in headless Chromium
@@ -26,7 +28,8 @@ rule rerun_logs:
 # tracked file, and needs Chromium.
 rule viewer_screenshot:
     input:
-        "results/rerun",
+        flights="results/rerun/_flight",
+        runs=expand("results/rerun/{method}", method=METHODS),
         code=script_code("viewer_screenshot"),
     output:
         "docs/viewer.png",

@@ -1,4 +1,5 @@
-"""Snakemake script: a screenshot of one recording in rerun's web viewer."""
+"""Snakemake script: a screenshot of one flight's recording in rerun's web viewer, its
+parts opened together."""
 
 import logging
 from pathlib import Path
@@ -8,11 +9,15 @@ from alfa_bench.workflow.viewer import screenshot, serve_recording
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
-rrd = Path(sm.input[0]) / f"{sm.params.flight}.rrd"
-if not rrd.exists():
-    raise FileNotFoundError(f"{rrd}: figures.viewer_flight names no recorded flight")
-with serve_recording(rrd) as url:
+flight = sm.params.flight
+own = Path(sm.input.flights) / f"{flight}.rrd"
+if not own.exists():
+    raise FileNotFoundError(f"{own}: figures.viewer_flight names no recorded flight")
+# the flight's own part, then each run's that scored it
+rrds = [own, *(p for d in sm.input.runs if (p := Path(d) / f"{flight}.rrd").exists())]
+with serve_recording(*rrds) as url:
     shown = screenshot(url, sm.output[0])
 if not shown.shows_recording:
-    raise RuntimeError(f"the viewer did not show {rrd} ({shown}); see {sm.output[0]}")
-logging.getLogger("alfa_bench").info("%s: %s", rrd, shown)
+    raise RuntimeError(f"the viewer did not show {flight}'s recording ({shown}); see "
+                       f"{sm.output[0]}")
+logging.getLogger("alfa_bench").info("%s: %s", flight, shown)

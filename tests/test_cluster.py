@@ -33,7 +33,7 @@ def test_the_slurm_profile_is_accepted_by_a_dry_run(corpus, tmp_path):
     done = snakemake(tmp_path, corpus.parent, "all", "-n", "--profile",
                      str(REPO / "profiles/slurm"))
     assert done.returncode == 0, done.stdout + done.stderr
-    assert "detect" in done.stdout and "rerun_logs" in done.stdout
+    assert "detect" in done.stdout and "run_parts" in done.stdout
 
 
 def test_jobs_run_through_the_generic_cluster_executor(corpus, tmp_path):

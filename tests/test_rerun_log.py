@@ -13,7 +13,9 @@ from alfa_bench.outputs.provenance import read_provenance
 from alfa_bench.outputs.rerun_log import (
     TIMELINE,
     blueprint,
+    write_flight_part,
     write_rerun_log,
+    write_run_part,
 )
 
 SIGNALS = ["roll_cmd", "roll", "roll_error", "roll_rate", "servo_aileron_left"]
@@ -70,6 +72,42 @@ def test_the_recording_holds_signals_scores_probes_and_events(recording):
     assert rows["/overview/fault"] == 2            # the bar from onset to the fault's end
     alarms = len(trace.alarm_intervals())
     assert rows["/events"] == 2 + alarms        # onset, end, one per alarm
+
+
+def _rows(path) -> dict[tuple[str, bool], int]:
+    """Rows per entity (and whether static) of a recording file."""
+    rows = {}
+    for line in rc.RrdReader(path).store().summary().splitlines():
+        entity, n, static = line.split()[:3]
+        rows[entity, static == "static=True"] = int(n.removeprefix("rows="))
+    return rows
+
+
+def test_a_flights_parts_hold_its_whole_recording(recording, tmp_path):
+    """The flight's part and each run's, written apart (as the workflow does, so that
+    a changed run rewrites its own), are one recording for the viewer: the same id,
+    and together the entities and rows of the recording written whole; the layout is
+    the flight's part's alone, and each part carries its own provenance."""
+    flight, trace, (whole, _) = recording
+    own, run = tmp_path / "flight.rrd", tmp_path / "run.rrd"
+    write_flight_part(flight, ["rls"], SIGNALS, own, {"inputs": {"flight": "0" * 64}})
+    write_run_part(flight.id, "rls", trace, run, {"inputs": {"run": "1" * 64}})
+    readers = [rc.RrdReader(p) for p in (own, run)]
+    assert [[e.recording_id for e in r.recordings()] for r in readers] == [[flight.id]] * 2
+    assert [len(r.blueprints()) for r in readers] == [1, 0]
+    parts = {}
+    for path in (own, run):
+        for key, n in _rows(path).items():
+            parts[key] = parts.get(key, 0) + n
+    # one provenance property in each file, where the whole has one
+    assert parts.pop(("/__properties/provenance", True)) == 2
+    whole_rows = _rows(whole)
+    assert whole_rows.pop(("/__properties/provenance", True)) == 1
+    assert parts == whole_rows
+    assert ("/methods/rls/scores/0", False) in _rows(run)
+    assert not any(e.startswith("/signals/") for e, _ in _rows(run))
+    assert read_provenance(own) == {"inputs": {"flight": "0" * 64}}
+    assert read_provenance(run) == {"inputs": {"run": "1" * 64}}
 
 
 def test_the_fault_and_flight_are_recording_properties(recording):

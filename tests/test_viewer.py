@@ -1,6 +1,7 @@
 """A recording opened in rerun's web viewer in headless Chromium shows the flight and
-its fault, not rerun's welcome screen. Skipped, with the reason, where Chromium or
-Playwright is missing (Debian: apt-get install chromium)."""
+its fault, not rerun's welcome screen, also when opened from its parts. Skipped, with
+the reason, where Chromium or Playwright is missing (Debian: apt-get install
+chromium)."""
 
 import urllib.request
 
@@ -10,7 +11,7 @@ from unavailable import require_module, unavailable
 
 from alfa_bench.data import load_flight
 from alfa_bench.methods import make_detector, run_detector
-from alfa_bench.outputs.rerun_log import write_rerun_log
+from alfa_bench.outputs.rerun_log import write_flight_part, write_rerun_log, write_run_part
 from alfa_bench.workflow.viewer import check_screenshot, chromium, screenshot, serve_recording
 
 require_module("playwright", "Playwright is not installed: the viewer check did not run",
@@ -27,14 +28,23 @@ def test_the_welcome_screen_is_not_taken_for_a_recording():
 
 
 @pytest.mark.slow
-def test_the_recording_renders_open_on_the_fault(corpus, tmp_path):
+@pytest.mark.parametrize("parts", [False, True], ids=["whole", "parts"])
+def test_the_recording_renders_open_on_the_fault(corpus, tmp_path, parts):
+    """Written whole, or as the workflow writes it: the flight's part and a run's, the
+    run's given first, so that the viewer meets the layout after the data."""
     flight = load_flight(next(p for p in sorted(corpus.iterdir()) if "engine" in p.name))
     detector = make_detector("rls_arx_zscore", {"pairs": [
         {"name": "roll", "input": "roll_cmd", "output": "roll"}]})
-    rrd = tmp_path / f"{flight.id}.rrd"
-    write_rerun_log(flight, {"rls_arx_zscore": run_detector(detector, flight, probes=True)},
-                    ["roll_cmd", "roll", "roll_rate"], rrd, {"inputs": {}})
-    with serve_recording(rrd) as url:
+    trace = run_detector(detector, flight, probes=True)
+    signals = ["roll_cmd", "roll", "roll_rate"]
+    if parts:
+        rrds = [tmp_path / "rls_arx_zscore.rrd", tmp_path / "flight.rrd"]
+        write_run_part(flight.id, "rls_arx_zscore", trace, rrds[0], {"inputs": {}})
+        write_flight_part(flight, ["rls_arx_zscore"], signals, rrds[1], {"inputs": {}})
+    else:
+        rrds = [tmp_path / f"{flight.id}.rrd"]
+        write_rerun_log(flight, {"rls_arx_zscore": trace}, signals, rrds[0], {"inputs": {}})
+    with serve_recording(*rrds) as url:
         shown = screenshot(url, tmp_path / "viewer.png")
     assert shown.shows_recording, shown
     with pytest.raises(OSError):     # the server is gone with its launcher, not left running

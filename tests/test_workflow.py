@@ -97,9 +97,11 @@ def test_inspection_outputs_sweeps_figures_and_paper(runs, corpus):
     out = work / "results"
     config = yaml.safe_load((REPO / "config/config.yaml").read_text())
     flights = sorted(p.name for p in corpus.iterdir())
-    assert sorted(p.stem for p in (out / "rerun").glob("*.rrd")) == flights
+    # each flight's recording in parts: its own, and each run's
+    assert sorted(p.stem for p in (out / "rerun/_flight").glob("*.rrd")) == flights
     for method in config["methods"]:
         assert sorted(p.stem for p in (out / "traces" / method).glob("*.npz")) == flights
+        assert sorted(p.stem for p in (out / "rerun" / method).glob("*.rrd")) == flights
     sweep = read_table(out / "tables/sweep.csv")
     assert set(sweep["method"]) == set(config["methods"])
     assert (sweep["scale"] == 1.0).any()
@@ -293,9 +295,15 @@ def test_every_result_file_records_its_provenance(runs, corpus):
         assert prov["code"]["version"] and "git_commit" in prov["code"], path
         assert prov["packages"]["numpy"] and prov["config"], path
         inputs = prov["inputs"]
-        if path.suffix in (".json", ".npz"):       # one flight's run, and its calibration
+        if path.suffix in (".json", ".npz") or (
+                path.suffix == ".rrd" and path.parent.name != "_flight"):
+            # one flight's run, and its calibration (a run's part of a recording: its trace's)
             assert len(inputs["flight_sha256"]) == 64, path
             checksums = inputs["calibration_sha256"]
+        elif path.suffix == ".rrd":          # a flight's own part of its recording
+            assert len(inputs["flight_sha256"]) == 64, path
+            assert set(prov["config"]) == {"runs", "signals"}, path
+            continue
         elif path.suffix == ".jsonl":       # every injected flight's run, and the folds'
             checksums = inputs["flight_sha256"]
             assert set(checksums) == injected, path
@@ -679,7 +687,7 @@ def test_a_corpus_of_every_damage_runs_to_the_end_and_scores_every_clean_flight(
     assert "topic file is missing" in why["carbonZ_2018-09-11-17-55-30_1_right_aileron_failure"]
     assert "empty file" in why["carbonZ_2018-09-11-14-22-07_2_no_failure"]
     assert "held longer than 1.0 s" in why["carbonZ_2018-10-05-15-55-10_elevator_failure"]
-    recorded = {p.stem for p in (work / "results/rerun").glob("*.rrd")}
+    recorded = {p.stem for p in (work / "results/rerun/_flight").glob("*.rrd")}
     assert clean - {p for p in clean if "no_ground_truth" in p} <= recorded
 
 

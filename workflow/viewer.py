@@ -1,6 +1,7 @@
 """A recording in rerun's web viewer, in a real browser: serve, load, screenshot, check.
 
-``serve_recording`` starts ``rerun --serve-web`` on loopback ports for one ``.rrd``;
+``serve_recording`` starts ``rerun --serve-web`` on loopback ports for the ``.rrd``
+files of one recording (a flight's parts, which the viewer opens as one);
 ``screenshot`` loads the viewer in headless Chromium (driven by Playwright) and
 waits until the page shows the recording rather than rerun's welcome screen.
 
@@ -54,12 +55,13 @@ def _free_port() -> int:
 
 
 @contextlib.contextmanager
-def serve_recording(rrd: str | Path, timeout_s: float = 30.0):
-    """Serve ``rrd`` to rerun's web viewer on loopback; yield the viewer's URL."""
+def serve_recording(*rrds: str | Path, timeout_s: float = 30.0):
+    """Serve the files ``rrds`` to rerun's web viewer on loopback; yield the viewer's
+    URL."""
     grpc, web = _free_port(), _free_port()
     rerun = Path(sys.executable).with_name("rerun")
     cmd = [str(rerun), "--serve-web", "--bind", "127.0.0.1", "--port", str(grpc),
-           "--web-viewer-port", str(web), str(rrd)]
+           "--web-viewer-port", str(web), *map(str, rrds)]
     env = {**os.environ, "RERUN_ANALYTICS": "0"}
     # a file, not a pipe: a server that logs more than a pipe holds would block on it
     log = tempfile.TemporaryFile()
@@ -72,7 +74,7 @@ def serve_recording(rrd: str | Path, timeout_s: float = 30.0):
         while not _answers(f"http://127.0.0.1:{web}/"):
             if proc.poll() is not None or time.monotonic() > deadline:
                 log.seek(0)
-                raise RuntimeError(f"rerun --serve-web did not start for {rrd}: "
+                raise RuntimeError(f"rerun --serve-web did not start for {rrds}: "
                                    f"{log.read().decode(errors='replace')}")
             time.sleep(0.2)
         source = urllib.parse.quote(f"rerun+http://127.0.0.1:{grpc}/proxy", safe="")
