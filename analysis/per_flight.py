@@ -45,7 +45,8 @@ from .isolation import named_class, names_class
 from .scoring import flight_outcome
 from .stability import survival
 
-__all__ = ["margins", "per_flight_markdown", "per_flight_table", "subset_counts", "verdict"]
+__all__ = ["margins", "per_flight_frame", "per_flight_markdown", "per_flight_rows",
+           "per_flight_table", "subset_counts", "verdict"]
 
 
 def verdict(onset_s: float | None, first_alarm_s: float | None, channel: str | None,
@@ -91,13 +92,11 @@ def margins(trace: Trace, onset_s: float | None,
     return in_time[0], in_time[1], peak(before)[0]
 
 
-def per_flight_table(records: list[dict], traces: Mapping[tuple[str, str], Trace],
-                     manifest: pd.DataFrame, deadline_s: float,
-                     subset: str = "all") -> pd.DataFrame:
-    """One row per record of a flight of ``subset``: method, block, flight, fault class,
-    emergency trajectory, onset, first alarm, delay, the first channel, the outcome
-    under ``deadline_s``, the verdict and the :func:`margins` from ``traces`` (by
-    method and flight)."""
+def per_flight_rows(records: list[dict], traces: Mapping[tuple[str, str], Trace],
+                    manifest: pd.DataFrame, deadline_s: float,
+                    subset: str = "all") -> list[dict]:
+    """The rows of :func:`per_flight_table`, in the order of ``records``: a run's
+    alone are its part of the table (:func:`per_flight_frame` merges the parts)."""
     flights = set(subset_flights(manifest, subset))
     emr = manifest.set_index("flight")["emergency_trajectory"]
     rows = []
@@ -122,6 +121,12 @@ def per_flight_table(records: list[dict], traces: Mapping[tuple[str, str], Trace
                                (detected, r["fault_class"]) if other else None),
             "margin_in_time": in_time, "margin_channel": margin_channel,
             "margin_before": before, "survival": survival(r, deadline_s)})
+    return rows
+
+
+def per_flight_frame(rows: list[dict]) -> pd.DataFrame:
+    """The table of :func:`per_flight_rows` (every run's, in run order), ordered by
+    block, method and flight."""
     table = pd.DataFrame(rows)
     if table.empty:
         return table
@@ -129,6 +134,16 @@ def per_flight_table(records: list[dict], traces: Mapping[tuple[str, str], Trace
     return table.sort_values(["block", "method", "flight"],
                              key=lambda c: c.map(order) if c.name == "block" else c,
                              kind="stable").reset_index(drop=True)
+
+
+def per_flight_table(records: list[dict], traces: Mapping[tuple[str, str], Trace],
+                     manifest: pd.DataFrame, deadline_s: float,
+                     subset: str = "all") -> pd.DataFrame:
+    """One row per record of a flight of ``subset``: method, block, flight, fault class,
+    emergency trajectory, onset, first alarm, delay, the first channel, the outcome
+    under ``deadline_s``, the verdict and the :func:`margins` from ``traces`` (by
+    method and flight)."""
+    return per_flight_frame(per_flight_rows(records, traces, manifest, deadline_s, subset))
 
 
 def per_flight_markdown(table: pd.DataFrame, deadline_s: float) -> str:

@@ -30,7 +30,7 @@ from alfa_bench.methods import Trace
 from .blocks import block
 from .scoring import flight_outcome, summarize
 
-__all__ = ["DEFAULT_SCALES", "flight_curves", "ratio", "sweep_table"]
+__all__ = ["DEFAULT_SCALES", "flight_curves", "merge_sweeps", "ratio", "sweep_table"]
 
 #: :math:`\kappa` from 1/100 to 10^4, 50 per decade; 1 is on it exactly.
 DEFAULT_SCALES = 10.0 ** (np.arange(-100, 201) / 50)
@@ -98,6 +98,16 @@ def sweep_table(records: list[dict], traces: Mapping[tuple[str, str], Trace],
                     "fault_free_hours": hours,
                 })
     return pd.DataFrame(rows)
+
+
+def merge_sweeps(parts: pd.DataFrame, subsets) -> pd.DataFrame:
+    """The :func:`sweep_table` of every run from each run's own (``parts``: stacked in
+    run order), in its order: subset by subset, the runs in order within each."""
+    if parts.empty:
+        return parts
+    order = {s: i for i, s in enumerate(subsets)}
+    return parts.sort_values("subset", key=lambda c: c.map(order),
+                             kind="stable").reset_index(drop=True)
 
 
 def _score(records: list[dict], firsts: np.ndarray, deadline_s: float) -> tuple[dict, dict]:

@@ -15,13 +15,19 @@ import pandas as pd
 
 from alfa_bench.analysis.blocks import block
 
-__all__ = ["records_table", "write_parquet"]
+__all__ = ["record_rows", "records_table", "write_parquet"]
 
 
 def records_table(records: list[dict]) -> pd.DataFrame:
     """One row per detection record: what it ran, on which flight, how it was
     calibrated, and what it found (first alarm, the paper's outcome, the isolated
     sensor). The nested parts (channels, intervals, fitted values) stay in the JSON."""
+    return pd.DataFrame(record_rows(records))
+
+
+def record_rows(records: list[dict]) -> list[dict]:
+    """The rows of :func:`records_table`, in the order of ``records``: a run's alone
+    are its part of the table."""
     rows = []
     for r in records:
         cal = r.get("calibration") or {}
@@ -36,7 +42,7 @@ def records_table(records: list[dict]) -> pd.DataFrame:
             "calibration_flights": len(cal.get("flights", [])),
             "grid_rate_hz": r["grid"]["rate_hz"], "grid_samples": r["grid"]["samples"],
         })
-    return pd.DataFrame(rows)
+    return rows
 
 
 def write_parquet(table: pd.DataFrame, path: str | Path, prov: dict) -> None:

@@ -43,12 +43,12 @@ rule injected_csv:
         "../scripts/injected_csv.py"
 
 
+# every run's rows, from its part (rules/parts.smk)
 rule detectability:
     input:
         manifest="results/injected/flights.csv",
         calibrate_on="results/flights.csv",
-        detections=expand("results/injected/detections/{method}", method=DETECTORS),
-        clean=expand("results/detections/{method}", method=DETECTORS),
+        parts=expand("results/parts/detectability/{method}.csv", method=DETECTORS),
         code=script_code("detectability"),
     output:
         csv=report("results/tables/detectability.csv",
@@ -68,13 +68,13 @@ rule detectability:
         "../scripts/detectability.py"
 
 
+# every run's rows, from its parts (rules/parts.smk)
 rule isolation:
     input:
         manifest="results/flights.csv",
         injected="results/injected/flights.csv",
-        detections=expand("results/detections/{method}", method=DETECTORS),
-        injected_detections=expand("results/injected/detections/{method}",
-                                   method=DETECTORS),
+        sensors=expand("results/parts/isolation_sensors/{method}.csv", method=DETECTORS),
+        actuators=expand("results/parts/isolation_actuators/{method}.csv", method=DETECTORS),
         code=script_code("isolation"),
     output:
         sensors_csv="results/tables/isolation_sensors.csv",

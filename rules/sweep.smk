@@ -1,10 +1,10 @@
+# every run's sweep, from its part (rules/parts.smk)
 rule sweep:
     # among the jobs ready, first: the paper waits on it
     priority: 2
     input:
         manifest="results/flights.csv",
-        detections=expand("results/detections/{method}", method=METHODS),
-        traces=expand("results/traces/{method}", method=METHODS),
+        parts=expand("results/parts/sweep/{method}.csv", method=METHODS),
         code=script_code("sweep"),
     output:
         # not in the report: 7.6 MB of rows no reader reads there (the figure is)
@@ -13,7 +13,6 @@ rule sweep:
                       category="Threshold sweeps"),
     params:
         subsets=SUBSETS,
-        deadline_s=config["scoring"]["deadline_s"],
         subset=PRIMARY,
     resources:
         **JOB_RESOURCES,

@@ -99,11 +99,12 @@ rule stability_refit:
         "../scripts/stability_refit.py"
 
 
+# every run's rows, from its parts (rules/parts.smk)
 rule per_flight:
     input:
         manifest="results/flights.csv",
-        detections=expand("results/detections/{method}", method=METHODS),
-        traces=expand("results/traces/{method}", method=METHODS),
+        parts=expand("results/parts/per_flight/{method}.jsonl", method=METHODS),
+        records=expand("results/parts/records/{method}.jsonl", method=METHODS),
         code=script_code("per_flight"),
     output:
         csv="results/tables/per_flight.csv",

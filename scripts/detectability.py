@@ -1,21 +1,21 @@
-"""Snakemake script: the detectability table and curves of the injected sensor faults."""
+"""Snakemake script: the detectability table and curves of the injected sensor faults,
+merged from each run's part."""
 
 from pathlib import Path
 
-from alfa_bench.analysis.detectability import detectability_markdown, detectability_table
+from alfa_bench.analysis.detectability import detectability_markdown
 from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.data import read_manifest
 from alfa_bench.outputs.figures import detectability_figure
+from alfa_bench.outputs.parts import read_parts
 from alfa_bench.outputs.provenance import stamp
-from alfa_bench.outputs.records import iter_records, read_records
 from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 manifest = read_manifest(sm.input.manifest)
 real = read_manifest(sm.input.calibrate_on)
-table = detectability_table(iter_records(sm.input.detections), manifest,
-                            read_records(sm.input.clean))
+table = read_parts(sm.input.parts)
 table.to_csv(sm.output.csv, index=False)
 Path(sm.output.md).write_text(detectability_markdown(table))
 detectability_figure(table, sm.output.figure)

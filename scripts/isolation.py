@@ -1,22 +1,23 @@
 """Snakemake script: isolation confusion matrices, of the injected sensor faults (which
-sensor) and of ALFA's actuator faults (which actuator class)."""
+sensor) and of ALFA's actuator faults (which actuator class), merged from each run's
+part."""
 
 from pathlib import Path
 
-from alfa_bench.analysis.isolation import isolation_markdown, isolation_rows
+from alfa_bench.analysis.isolation import isolation_markdown
 from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.data import read_manifest
+from alfa_bench.outputs.parts import read_parts
 from alfa_bench.outputs.provenance import stamp
-from alfa_bench.outputs.records import iter_records
 from alfa_bench.workflow.logs import log_to
 
 sm = snakemake  # noqa: F821
 log_to(sm.log[0])
 real, injected = read_manifest(sm.input.manifest), read_manifest(sm.input.injected)
-for records, truth, csv, md in [
-        (sm.input.injected_detections, "sensor", sm.output.sensors_csv, sm.output.sensors_md),
-        (sm.input.detections, "actuator", sm.output.actuators_csv, sm.output.actuators_md)]:
-    rows = isolation_rows(iter_records(records), truth)
+for parts, truth, csv, md in [
+        (sm.input.sensors, "sensor", sm.output.sensors_csv, sm.output.sensors_md),
+        (sm.input.actuators, "actuator", sm.output.actuators_csv, sm.output.actuators_md)]:
+    rows = read_parts(parts)
     rows.to_csv(csv, index=False)
     Path(md).write_text(isolation_markdown(rows, truth))
     prov = (run_provenance(sm.config, injected, real) if truth == "sensor"

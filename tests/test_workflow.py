@@ -280,8 +280,10 @@ def test_every_result_file_records_its_provenance(runs, corpus):
     # parsed-flight cache is keyed by them
     files = [p for p in (work / "results").rglob("*") if p.is_file()
              and not p.name.startswith(".snakemake")     # Snakemake's directory markers
-             and not {"logs", "benchmarks", "cache", "rerun_parts", "figure_parts",
-                      "fits"}       # the fits the jobs share: model files, no result
+             # the fits the jobs share (model files, no result), and each run's parts
+             # of the tables (its rows, whose table records the provenance)
+             and not {"logs", "benchmarks", "cache", "rerun_parts", "figure_parts", "fits",
+                      "parts"}
              & set(p.relative_to(work).parts)
              and p not in (work / "results/injected/flights.csv", work / RUN_FILE)
              and p.name != RUN_RECORD]     # what the injected records share: read through them
@@ -357,6 +359,54 @@ def test_every_results_path_the_docs_name_is_made_by_the_workflow(runs):
     missing = [p for p in sorted(named) for q in _expand(p)
                if not list(runs[0].glob(q.rstrip("/")))]
     assert not missing, missing
+
+
+def test_the_tables_merged_from_each_runs_part_are_those_of_every_run_at_once(runs):
+    """sweep, per_flight, the records, detectability and isolation are merged from
+    each run's part (rules/parts.smk): each equals, byte for byte (Parquet: its
+    table), the table computed from every run's records and traces in one go."""
+    import io
+
+    import pandas as pd
+
+    from alfa_bench.analysis.detectability import detectability_table
+    from alfa_bench.analysis.isolation import isolation_rows
+    from alfa_bench.analysis.per_flight import per_flight_table
+    from alfa_bench.analysis.sweep import sweep_table
+    from alfa_bench.data import read_manifest
+    from alfa_bench.outputs.parquet import records_table
+    from alfa_bench.outputs.records import read_records
+    from alfa_bench.outputs.traces import read_traces
+
+    out = runs[0] / "results"
+    config = yaml.safe_load((REPO / "config/config.yaml").read_text())
+    methods = list(config["methods"])
+    detectors = [m for m in methods if config["methods"][m].get("role") != "reference"]
+    primary = config["primary_subset"]
+    subsets = [primary, *(s for s in config["subsets"] if s != primary)]
+    deadline = config["scoring"]["deadline_s"]
+    manifest, injected = (read_manifest(out / "flights.csv"),
+                          read_manifest(out / "injected/flights.csv"))
+    records = read_records([out / "detections" / m for m in methods])
+    traces = read_traces([out / "traces" / m for m in methods], probes=False)
+    on_grid = [out / "injected/detections" / m for m in detectors]
+    clean = [r for r in records if r["method"] in detectors]
+
+    def csv(table):
+        return table.to_csv(index=False).encode()
+
+    whole = {
+        "sweep": csv(sweep_table(records, traces, manifest, subsets, deadline)),
+        "per_flight": csv(per_flight_table(records, traces, manifest, deadline)),
+        "detectability": csv(detectability_table(iter_records(on_grid), injected, clean)),
+        "isolation_sensors": csv(isolation_rows(iter_records(on_grid), "sensor")),
+        "isolation_actuators": csv(isolation_rows(clean, "actuator")),
+    }
+    assert len(pd.read_csv(io.BytesIO(whole["detectability"]))) > 0
+    for table, expected in whole.items():
+        assert (out / f"tables/{table}.csv").read_bytes() == expected, table
+    merged = pd.read_parquet(out / "tables/detections.parquet")
+    pd.testing.assert_frame_equal(merged, records_table(records))
 
 
 def test_two_runs_are_byte_identical(runs):
@@ -599,8 +649,16 @@ def test_every_csv_reads_plainly_with_its_documented_header(runs):
                                  .read_text(), flags=re.M))
     work = runs[0]
     found = sorted(p for p in (work / "results").rglob("*.csv")
-                   if "detections" not in p.parts)
+                   if "detections" not in p.parts and "parts" not in p.parts)
     assert {p.relative_to(work).as_posix() for p in found} == set(documented)
+    # a run's part of a table is its rows of it: the table's header
+    parts = sorted((work / "results/parts").glob("*/*.csv"))
+    assert {p.parent.name for p in parts} == {"sweep", "detectability", "isolation_sensors",
+                                              "isolation_actuators"}
+    for path in parts:
+        table = f"results/tables/{path.parent.name}.csv"
+        assert list(pd.read_csv(path).columns) == re.findall(r"`([^`]+)`",
+                                                             documented[table]), path
     for path in found:
         header = re.findall(r"`([^`]+)`", documented[path.relative_to(work).as_posix()])
         frame = pd.read_csv(path)

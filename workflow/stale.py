@@ -12,7 +12,11 @@ __all__ = ["PER_RUN", "RETIRED", "remove", "stale_results"]
 #: where each run writes, ``{run}`` its name
 PER_RUN = ("detections/{run}", "traces/{run}", "figure_parts/{run}",
            "injected/detections/{run}", "benchmarks/detect/{run}.tsv", "logs/detect/{run}.log",
-           "rerun/{run}", "benchmarks/run_parts/{run}.tsv", "logs/run_parts/{run}.log")
+           "rerun/{run}", "benchmarks/run_parts/{run}.tsv", "logs/run_parts/{run}.log",
+           *(f"parts/{table}/{{run}}.csv" for table in ("sweep", "detectability",
+                                                         "isolation_sensors",
+                                                         "isolation_actuators")),
+           *(f"parts/{table}/{{run}}.jsonl" for table in ("per_flight", "records")))
 #: what earlier versions of the workflow wrote and this one does not, as globs: each
 #: run's part of the recordings kept beside them, and the recordings written whole
 #: (each flight's are in parts now, under ``rerun/<part>/``)
