@@ -12,6 +12,7 @@ from alfa_bench.workflow.preflight import alfa_dir_problem, failure_message, sto
 from alfa_bench.workflow import forkserver
 from alfa_bench.workflow.dependencies import module_sources, script_sources
 from alfa_bench.workflow.detect_job import SERVER_ENV, write_job_config
+from alfa_bench.workflow.parts_job import SERVER_ENV as PARTS_SERVER_ENV
 from alfa_bench.workflow.logs import closing_lines
 from alfa_bench.workflow.stale import remove, stale_results
 from alfa_bench.workflow.resources import count_flights, job_resources
@@ -141,10 +142,25 @@ DETECT_JOB = (f"{shlex.quote(sys.executable)} -m alfa_bench.workflow.detect_job 
               "{params.injected}")
 
 
+# A run's parts job's command (workflow/parts_job.py)
+PARTS_JOB = (f"{shlex.quote(sys.executable)} -m alfa_bench.workflow.parts_job "
+             "{wildcards.method} --manifest {input.manifest:q} "
+             "--detections {input.detections:q} --traces {input.traces:q} "
+             "--recordings {output.recordings:q} --sweep {output.sweep:q} "
+             "--per-flight {output.per_flight:q} --records {output.records:q} "
+             "--subsets {params.subsets:q} --deadline-s {params.deadline_s} --log {log:q} "
+             "{params.injected}")
+
+
 # On one machine the detect jobs fork from a server that has loaded the imports and the
-# flights once (workflow/forkserver.py); a cluster's jobs run each in its own process.
+# flights once, and the parts jobs from another (workflow/forkserver.py); a cluster's
+# jobs run each in its own process.
 onstart:
-    if workflow.local_exec and any(j.rule.name.startswith("detect")
-                                   for j in workflow.dag.needrun_jobs()):
-        forkserver.start(SERVER_ENV, "alfa_bench.workflow.detect_job:server_jobs", [JOB_CONFIG],
-                         "results/logs/detect_server.log")
+    if workflow.local_exec:
+        needed = {j.rule.name for j in workflow.dag.needrun_jobs()}
+        if any(name.startswith("detect") for name in needed):
+            forkserver.start(SERVER_ENV, "alfa_bench.workflow.detect_job:server_jobs",
+                             [JOB_CONFIG], "results/logs/detect_server.log")
+        if any(name.startswith("run_parts") for name in needed):
+            forkserver.start(PARTS_SERVER_ENV, "alfa_bench.workflow.parts_job:server_jobs",
+                             [], "results/logs/parts_server.log")

@@ -2,6 +2,7 @@
 # its message last, the details in its log (Snakemake's own lines come before)
 onerror:
     forkserver.stop(SERVER_ENV)
+    forkserver.stop(PARTS_SERVER_ENV)
     if _last := failure_message(ALFA_SOURCE, ALFA_DIR):
         print(f"\n{_last}", file=sys.stderr)
 

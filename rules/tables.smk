@@ -3,6 +3,7 @@
 # lines (the log's path, the time taken) after this block
 onsuccess:
     forkserver.stop(SERVER_ENV)
+    forkserver.stop(PARTS_SERVER_ENV)
     if _closing := closing_lines(PRIMARY):
         atexit.register(print, *_closing, sep="\n", file=sys.stderr, flush=True)
 

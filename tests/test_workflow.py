@@ -850,3 +850,40 @@ def test_a_run_taken_out_of_the_config_is_named_removable_and_never_compared(run
     run_workflow(work, corpus.parent, *config, target="remove_stale")
     assert not (work / "results/detections/gone_run").exists()
     assert (work / "results/detections/silent").is_dir()
+
+
+def test_a_parts_job_forked_from_its_server_writes_what_it_writes_alone(runs, tmp_path):
+    """The run's parts jobs forked from the parts server (the local run); the job of a
+    run scored on the injected grid, run again in a process of its own as a cluster
+    runs it, writes the same parts byte for byte and the same recordings."""
+    from recordings import content
+
+    from alfa_bench.workflow import parts_job
+
+    work, method = runs[0], "glrt_arx"
+    config = yaml.safe_load((REPO / "config/config.yaml").read_text())
+    primary = config["primary_subset"]
+    out = {"sweep": "sweep/m.csv", "per_flight": "per_flight/m.jsonl",
+           "records": "records/m.jsonl", "detectability": "detectability/m.csv",
+           "isolation_sensors": "isolation_sensors/m.csv",
+           "isolation_actuators": "isolation_actuators/m.csv"}
+    argv = [method, "--manifest", str(work / "results/flights.csv"),
+            "--detections", str(work / f"results/detections/{method}"),
+            "--traces", str(work / f"results/traces/{method}"),
+            "--recordings", str(tmp_path / "rerun"), "--log", str(tmp_path / "log"),
+            "--subsets", json.dumps([primary, *(s for s in config["subsets"] if s != primary)]),
+            "--deadline-s", str(config["scoring"]["deadline_s"]),
+            "--injected-manifest", str(work / "results/injected/flights.csv"),
+            "--injected", str(work / f"results/injected/detections/{method}"),
+            *(a for k, v in out.items() for a in (f"--{k.replace('_', '-')}",
+                                                  str(tmp_path / v)))]
+    os.environ.pop(parts_job.SERVER_ENV, None)
+    assert parts_job.main(argv) == 0
+    for table, path in out.items():
+        made = work / f"results/parts/{table}/{method}{Path(path).suffix}"
+        assert (tmp_path / path).read_bytes() == made.read_bytes(), table
+    recordings = sorted((work / f"results/rerun/{method}").glob("*.rrd"))
+    assert recordings and [p.name for p in recordings] == sorted(
+        p.name for p in (tmp_path / "rerun").glob("*.rrd"))
+    for p in recordings:
+        assert content(p) == content(tmp_path / "rerun" / p.name), p.name

@@ -106,28 +106,18 @@ def preload(config: dict) -> None:
     for spec in config["methods"].values():
         make_detector(spec["detector"], spec.get("params")).check_params()
     FlightPanel("")                 # matplotlib's fonts and text metrics, loaded
-    _SOURCES.update(_source_times())
+    from .forkserver import imported_sources
 
-
-def _source_times() -> dict[str, int]:
-    """The modification time of each imported module of the project, by file."""
-    times = {}
-    for name, module in list(sys.modules.items()):
-        path = getattr(module, "__file__", None)
-        if name.startswith("alfa_bench") and path:
-            try:
-                times[path] = os.stat(path).st_mtime_ns
-            except OSError:
-                times[path] = -1
-    return times
+    _SOURCES.update(imported_sources())
 
 
 def code_changed() -> bool:
     """Whether a module of the project imported by :func:`preload` changed since: a
     job forked now would run the old code, and its outputs, newer than the change,
     would never be re-run."""
-    return any(os.stat(p).st_mtime_ns != t if os.path.exists(p) else True
-               for p, t in _SOURCES.items())
+    from .forkserver import changed_since
+
+    return changed_since(_SOURCES)
 
 
 def prepare(args: argparse.Namespace) -> tuple:

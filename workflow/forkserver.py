@@ -1,5 +1,6 @@
-"""The detect jobs' fork server: the imports and the flights loaded once per run of the
-workflow, each job a fork of them.
+"""The jobs' fork servers: the imports (and for the detect jobs, the flights) loaded once
+per run of the workflow, each job a fork of them. The detect jobs have one
+(:mod:`.detect_job`), the runs' parts jobs another (:mod:`.parts_job`).
 
 A detect job started as a process of its own pays 1-2 s before its detector runs: the
 imports (numpy, pandas, scipy, scikit-learn, numba's kernels, the configured library
@@ -42,7 +43,8 @@ import time
 import traceback
 from pathlib import Path
 
-__all__ = ["killed", "serve", "start", "stop", "submit"]
+__all__ = ["changed_since", "imported_sources", "killed", "serve", "start", "stop",
+           "submit"]
 
 _STARTED, _EXITED = b"+", b"="
 #: the threads of the numerical libraries, fixed when they load: one, as Snakemake
@@ -62,6 +64,28 @@ _MEANINGS = {
     signal.SIGTERM: "stopped from outside: the workflow interrupted, or a time limit",
     signal.SIGINT: "interrupted (Ctrl-C)",
 }
+
+
+def imported_sources(package: str = "alfa_bench") -> dict[str, int]:
+    """The modification time of the file of each module of ``package`` this process
+    imported, by file: what a server's preload loaded (:func:`changed_since`)."""
+    times = {}
+    for name, module in list(sys.modules.items()):
+        path = getattr(module, "__file__", None)
+        if name.startswith(package) and path:
+            try:
+                times[path] = os.stat(path).st_mtime_ns
+            except OSError:
+                times[path] = -1
+    return times
+
+
+def changed_since(sources: dict[str, int]) -> bool:
+    """Whether a file of ``sources`` (:func:`imported_sources`) changed since: a job
+    forked now would run the old code, and its outputs, newer than the change, would
+    never be re-run."""
+    return any(os.stat(p).st_mtime_ns != t if os.path.exists(p) else True
+               for p, t in sources.items())
 
 
 def killed(signum: int) -> str:
@@ -96,7 +120,7 @@ def submit(path: str, argv: list[str]) -> int | None:
     if not reply.startswith(_STARTED):
         return None                  # the server went before it forked: nothing ran
     if _EXITED not in reply:
-        print(f"alfa-bench: the detect job's process (forked by the server at {path}) "
+        print(f"alfa-bench: the job's process (forked by the server at {path}) "
               "ended without an exit status; see the job's log", file=sys.stderr)
         return 1
     return int(reply.split(_EXITED)[1])
