@@ -229,24 +229,9 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     if "--config" not in argv and os.environ.get(CONFIG_ENV):
         argv = [*argv, "--config", os.environ[CONFIG_ENV]]    # this workflow's, to the server
-    server = os.environ.get(SERVER_ENV)
-    if server:
-        from .forkserver import killed, submit
+    from .forkserver import run_job
 
-        status = submit(server, argv)
-        if status is not None and status < 0:
-            # the fork could write nothing: its log says what ended it; the status is
-            # the shell's for a process killed by a signal
-            args = parse(argv)
-            line = f"alfa-bench: detect job {args.method}: {killed(-status)}"
-            with open(args.log, "a") as log:
-                print(line, file=log)
-            print(line, file=sys.stderr)
-            return 128 - status
-        if status is not None:
-            return status
-    run(parse(argv))
-    return 0
+    return run_job(SERVER_ENV, "detect", argv, parse, run)
 
 
 if __name__ == "__main__":

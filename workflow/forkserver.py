@@ -43,8 +43,8 @@ import time
 import traceback
 from pathlib import Path
 
-__all__ = ["changed_since", "imported_sources", "killed", "serve", "start", "stop",
-           "submit"]
+__all__ = ["changed_since", "imported_sources", "killed", "run_job", "serve", "start",
+           "stop", "submit"]
 
 _STARTED, _EXITED = b"+", b"="
 #: the threads of the numerical libraries, fixed when they load: one, as Snakemake
@@ -124,6 +124,29 @@ def submit(path: str, argv: list[str]) -> int | None:
               "ended without an exit status; see the job's log", file=sys.stderr)
         return 1
     return int(reply.split(_EXITED)[1])
+
+
+def run_job(env: str, kind: str, argv: list[str], parse, run) -> int:
+    """A job's command: run the job of ``argv`` on the server named in the environment
+    variable ``env`` when one answers, else here (``run(parse(argv))``); its exit
+    status. A job killed by a signal is named, as a ``kind`` job, in its log (the
+    ``log`` of ``parse(argv)``) and on standard error."""
+    server = os.environ.get(env)
+    if server:
+        status = submit(server, argv)
+        if status is not None and status < 0:
+            # the fork could write nothing: its log says what ended it; the status is
+            # the shell's for a process killed by a signal
+            args = parse(argv)
+            line = f"alfa-bench: {kind} job {args.method}: {killed(-status)}"
+            with open(args.log, "a") as log:
+                print(line, file=log)
+            print(line, file=sys.stderr)
+            return 128 - status
+        if status is not None:
+            return status
+    run(parse(argv))
+    return 0
 
 
 def _receive(conn: socket.socket) -> tuple[str, list[str], list[int]]:

@@ -24,7 +24,6 @@ from __future__ import annotations
 import argparse
 import json
 import logging
-import os
 import sys
 from pathlib import Path
 
@@ -130,21 +129,9 @@ def server_jobs() -> tuple:
 def main(argv: list[str] | None = None) -> int:
     """Run the job on the parts server when one answers, else here; its exit status."""
     argv = sys.argv[1:] if argv is None else argv
-    server = os.environ.get(SERVER_ENV)
-    if server:
-        from .forkserver import killed, submit
+    from .forkserver import run_job
 
-        status = submit(server, argv)
-        if status is not None and status < 0:
-            line = f"alfa-bench: parts job {parse(argv).method}: {killed(-status)}"
-            with open(parse(argv).log, "a") as log:
-                print(line, file=log)
-            print(line, file=sys.stderr)
-            return 128 - status
-        if status is not None:
-            return status
-    run(parse(argv))
-    return 0
+    return run_job(SERVER_ENV, "parts", argv, parse, run)
 
 
 if __name__ == "__main__":
