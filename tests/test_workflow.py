@@ -322,7 +322,7 @@ def test_a_changed_method_module_reruns_exactly_its_jobs(runs, overlay):
     """A changed detector module makes a dry run schedule the detect jobs (real flights
     and injected grid) of the runs whose detectors use it (here residual_bank, its
     energy variant, its nested selection, learned_fusion and the project's classifier
-    on top of it), and no other
+    on top of it), and their parts jobs, and no other
     method's: not the coincidence runs, which share its windows and thresholds
     (methods/windows.py, methods/extremes.py) but not its module. (Snakemake compares small
     inputs by content, so the module's text changes, by one comment line, and is
@@ -330,11 +330,10 @@ def test_a_changed_method_module_reruns_exactly_its_jobs(runs, overlay):
     done = dry_run_with_changed(REPO / "methods/residual_bank.py", runs[1], overlay[0],
                                 "test_workflow")
     jobs = re.findall(r"rule (\w+):\n(?:    .*\n)*?    wildcards: method=(\w+)", done.stdout)
-    assert sorted(jobs) == [("detect", m) for m in ("bench_logistic", "bench_logistic_no_emr",
-                                                    "learned_fusion", "residual_bank",
-                                                    "residual_bank_energy",
-                                                    "residual_bank_nested")], (
-        done.stdout + done.stderr)
+    using = ("bench_logistic", "bench_logistic_no_emr", "learned_fusion", "residual_bank",
+             "residual_bank_energy", "residual_bank_nested")
+    assert sorted(jobs) == sorted((rule, m) for rule in ("detect", "run_parts")
+                                  for m in using), done.stdout + done.stderr
 
 
 def _expand(path: str) -> list[str]:
