@@ -141,6 +141,7 @@ class BenchLogistic(ResidualLogistic):
     def _lookback(self) -> int:
         return self._history() + self.persist
 
+    feature_state = ("weights_", "sigma_", "bank_")
     #: what :meth:`fit_model` learns
     model_state = ("weights_", "sigma_", "bank_", "center_", "scale_", "coef_", "intercept_")
 

@@ -92,9 +92,10 @@ from .base import (
     leave_one_date_out,
 )
 from .extremes import MaximaThresholds
+from .fits import KeptFits, fit_key, segments_data
 from .windows import window_steps
 
-__all__ = ["CHANNELS", "INPUTS", "LONGEST_WINDOW_S", "WARMUP_S", "ResidualLogistic",
+__all__ = ["CHANNELS", "DESIGNS", "INPUTS", "LONGEST_WINDOW_S", "WARMUP_S", "ResidualLogistic",
            "ResidualLogisticPublished", "best_accuracy_threshold", "fit_residuals",
            "residual_features", "residuals"]
 
@@ -111,6 +112,14 @@ WARMUP_S = 15.0
 
 #: the longest trailing window of the features, s: what a step's features read
 LONGEST_WINDOW_S = 3.0
+
+#: the designs (feature models, features and labels) of the fits
+#: :meth:`_ResidualClassifier.fit_model` made in this process, by the code, the
+#: hyper-parameters that shape them (all but :math:`C` and the threshold's) and the data
+#: (:func:`~.fits.fit_key`): the 8 last used, since a nested selection fits the
+#: candidates that share them in turn (each on its inner folds and then whole), and a
+#: design holds every training step's features
+DESIGNS = KeptFits(8)
 
 #: the residual channels (1): target -> regressors (an intercept besides)
 CHANNELS = {"accel_x": ("altitude_error", "airspeed_error_ms", "pitch"),
@@ -262,11 +271,10 @@ class _ResidualClassifier:
         the persistence."""
         return self._steps(LONGEST_WINDOW_S) + self.persist
 
-    def fit_model(self, segments: list[Labelled]) -> _ResidualClassifier:
-        """Fit (1) on the nominal steps and the logistic regression on the steps after
-        the warm-up, positives as ``positives`` says; return self."""
-        if self.positives not in ("no_emr", "all"):
-            raise ValueError(f"positives must be 'no_emr' or 'all', got {self.positives!r}")
+    def design(self, segments: list[Labelled]) -> tuple[dict, np.ndarray, np.ndarray]:
+        """What the regression of a fit on ``segments`` reads: the feature models
+        (:attr:`feature_state`, fitted on the parts before onset), and the features
+        and labels of the steps after the warm-up, positives as ``positives`` says."""
         warm = self._steps(self.warmup_s)
         free, rows, labels = [], [], []
         for seg in segments:
@@ -283,6 +291,27 @@ class _ResidualClassifier:
             raise CalibrationError("residual logistic: the training steps hold "
                                    f"{'only faulty' if y.all() else 'no faulty'} steps; "
                                    "the classifier needs both")
+        return {n: getattr(self, n) for n in self.feature_state if n in vars(self)}, F, y
+
+    #: what :meth:`_fit_features` learns, in the order it sets it
+    feature_state = ("weights_", "sigma_")
+
+    def fit_model(self, segments: list[Labelled]) -> _ResidualClassifier:
+        """Fit (1) on the nominal steps and the logistic regression on the steps after
+        the warm-up, positives as ``positives`` says; return self. The features of a
+        fit (:meth:`design`) are kept in :data:`DESIGNS`: candidates that differ in
+        :math:`C` alone read the same."""
+        if self.positives not in ("no_emr", "all"):
+            raise ValueError(f"positives must be 'no_emr' or 'all', got {self.positives!r}")
+        shaping = {k: v for k, v in self.get_params().items()
+                   if k != "C" and k not in self.threshold_params}
+        key = fit_key(self, segments_data(segments), shaping)
+        design = DESIGNS.get(key)
+        if design is None:
+            design = self.design(segments)
+            DESIGNS.put(key, design)
+        state, F, y = design
+        self.__dict__.update(state)
         self.center_ = F.mean(axis=0)
         std = F.std(axis=0)
         self.scale_ = np.where(std > 0, std, 1.0)

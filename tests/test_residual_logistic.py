@@ -199,3 +199,27 @@ def test_an_unknown_feature_kind_is_refused_by_name():
     with pytest.raises(ValueError, match="window_s would not be read"):
         PyODDetector(features="residuals", window_s=5.0).check_params()
     PyODDetector(features="residuals").check_params()
+
+
+def test_candidates_that_differ_in_c_alone_build_the_features_once(monkeypatch):
+    """A nested selection's candidates that differ in C alone read the same features:
+    the second fit takes the first's design (DESIGNS), and gives what a fit of its own
+    gives; another positives rule is another design."""
+    from alfa_bench.methods.base import learned_digest
+    from alfa_bench.methods.fits import fresh_fits
+    from alfa_bench.methods.residual_logistic import DESIGNS
+
+    built = []
+    design = ResidualLogistic.design
+    monkeypatch.setattr(ResidualLogistic, "design",
+                        lambda self, segs: built.append(self.C) or design(self, segs))
+    with fresh_fits():
+        a = ResidualLogistic(C=1.0).fit_model(_corpus())
+        b = ResidualLogistic(C=0.01).fit_model(_corpus())
+        assert built == [1.0] and len(DESIGNS) == 1
+        ResidualLogistic(C=0.01, positives="all").fit_model(_corpus())
+        assert built == [1.0, 0.01]
+    with fresh_fits():
+        alone = ResidualLogistic(C=0.01).fit_model(_corpus())
+    assert not np.array_equal(a.coef_, b.coef_)
+    assert learned_digest(b) == learned_digest(alone)
