@@ -322,11 +322,16 @@ class KeptFits:
     name : str, optional
         The store's name in the folder's file names, apart from every other store's
         (whose fits under the same key are other things); None: in the process only.
+    counted : bool
+        Whether what it makes and gives again counts in :data:`COUNTS`: a store of
+        fits; not a store of what fits share (the logistic classifiers' designs), which
+        the cost table would count as fits.
     """
 
-    def __init__(self, kept: int, name: str | None = None):
+    def __init__(self, kept: int, name: str | None = None, counted: bool = True):
         self.kept = kept
         self.name = name
+        self.counted = counted
         self._fits: OrderedDict[str, object] = OrderedDict()
         _STORES.add(self)
 
@@ -345,7 +350,7 @@ class KeptFits:
             return None
         if key in self._fits:
             self._fits.move_to_end(key)
-            COUNTS["kept"] += 1
+            COUNTS["kept"] += self.counted
             return self._fits[key]
         files = self._files(key)
         if files is None:
@@ -363,7 +368,7 @@ class KeptFits:
         the least recently used beyond :attr:`kept`; and write it to the folder."""
         if key is None:
             return
-        COUNTS["made"] += 1
+        COUNTS["made"] += self.counted
         self._keep(key, fit)
         files = self._files(key)
         if files is not None:

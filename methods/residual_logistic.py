@@ -119,7 +119,7 @@ LONGEST_WINDOW_S = 3.0
 #: (:func:`~.fits.fit_key`): the 8 last used, since a nested selection fits the
 #: candidates that share them in turn (each on its inner folds and then whole), and a
 #: design holds every training step's features
-DESIGNS = KeptFits(8)
+DESIGNS = KeptFits(8, counted=False)
 
 #: the residual channels (1): target -> regressors (an intercept besides)
 CHANNELS = {"accel_x": ("altitude_error", "airspeed_error_ms", "pitch"),
