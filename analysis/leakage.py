@@ -182,6 +182,14 @@ def _verdict_p(k: int, n: int, p0: float) -> float:
     return float(binom.sf(k - 1, n, p0)) if n else math.nan
 
 
+#: the columns of :func:`leakage_table`, which it has when no flight has a fault too
+LEAKAGE_COLUMNS = ["signal", "kind", "fault_class", "emergency_trajectory", "flights",
+                   "not_measured", "flat_at_onset", "flat_share", "flat_chance_before",
+                   "flat_chance_fault_free", "flat_p", "goes_flat", "step_flights",
+                   "step_at_onset", "step_share", "step_chance_before",
+                   "step_chance_fault_free", "step_p", "steps", "leaks"]
+
+
 def leakage_table(flights: dict[str, Flight], flat_s: float = 1.0, before_s: float = 0.5,
                   after_s: float = 1.0, margin_s: float = 1.0, step_s: float = 0.1,
                   alpha: float = 0.01, step: StepTest = StepTest()) -> pd.DataFrame:
@@ -258,7 +266,7 @@ def leakage_table(flights: dict[str, Flight], flat_s: float = 1.0, before_s: flo
                 "step_p": step_p, "steps": steps,
                 "leaks": goes_flat or (steps and sig.kind == "setpoint"),
             })
-    return pd.DataFrame(rows)
+    return pd.DataFrame(rows, columns=LEAKAGE_COLUMNS)
 
 
 def leaking_flights(table: pd.DataFrame, manifest: pd.DataFrame, flights: list[str]
@@ -313,7 +321,11 @@ def leakage_markdown(table: pd.DataFrame, flat_s: float = 1.0,
     """The verdict per signal (its kind, the groups it goes flat, steps and leaks on,
     the flights on which it is not measured), then the evidence per signal and group
     for each test. A group is a fault class, marked ``(emr)`` for the flights with an
-    emergency trajectory."""
+    emergency trajectory. Without a flight with a fault (a corpus of fault-free logs)
+    there is no onset to audit, and it says so."""
+    if table.empty:
+        return ("## Which signals carry the label\n\nNo flight has a fault: there is no "
+                "onset at which a signal could carry the label, so nothing is audited.\n")
     verdict = []
     for signal, g in table.groupby("signal", sort=False):
         kind = g["kind"].iloc[0]

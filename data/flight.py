@@ -85,19 +85,27 @@ _FLIGHT_NAME = re.compile(
     r"^carbonZ_(?P<date>\d{4}-\d{2}-\d{2})-(?P<time>\d{2}-\d{2}-\d{2})"
     r"(?:_(?P<part>\d+))?_(?P<label>[A-Za-z0-9_]+)$"
 )
+#: a flight converted from a log (alfa_bench.logs.corpus): its group in the date's place
+_LOG_FLIGHT_NAME = re.compile(
+    r"^log_(?P<date>[A-Za-z0-9]+(?:-[A-Za-z0-9]+)*?)-(?P<time>\d{2}-\d{2}-\d{2})"
+    r"_(?P<part>\d+)_(?P<label>[A-Za-z0-9_]+)$"
+)
 
 
 def parse_flight_name(name: str) -> dict[str, str | int | None]:
-    """Split an ALFA flight folder name into date, time, part and fault label.
+    """Split an ALFA flight folder name into date, time, part and fault label; a flight
+    converted from a log (``log_<group>-hh-mm-ss_<N>_<label>``) gives its group as the
+    date, the unit its folds leave out.
 
     >>> parse_flight_name("carbonZ_2018-07-18-15-53-31_1_engine_failure")["label"]
     'engine_failure'
     """
-    m = _FLIGHT_NAME.match(name)
+    m = _FLIGHT_NAME.match(name) or _LOG_FLIGHT_NAME.match(name)
     if m is None:
         raise AlfaDataError(
             "folder name is not an ALFA flight name "
-            "(carbonZ_YYYY-MM-DD-hh-mm-ss[_N]_<label>)",
+            "(carbonZ_YYYY-MM-DD-hh-mm-ss[_N]_<label>) nor a converted log's "
+            "(log_<group>-hh-mm-ss_N_<label>)",
             flight=name,
         )
     part = m["part"]
@@ -348,9 +356,27 @@ def assemble_flight(path: str | Path, t0_ns: int, topics: dict[str, Topic],
     )
 
 
+def _classes(flight: str) -> dict[str, str]:
+    """Ground-truth topic -> fault class: ALFA's, and on a flight converted from a log
+    any ``failure_status-<class>`` its ``labels.csv`` named."""
+    return _GROUND_TRUTH_TOPICS if not flight.startswith("log_") else _AnyClass()
+
+
+class _AnyClass(dict):
+    def __init__(self):
+        super().__init__(_GROUND_TRUTH_TOPICS)
+
+    def __missing__(self, topic: str) -> str:
+        return topic.removeprefix("failure_status-")
+
+    def __contains__(self, topic) -> bool:
+        return str(topic).startswith("failure_status-")
+
+
 def _ground_truth(flight: str, label: str, topics: dict[str, Topic]) -> Fault | None:
     gt = sorted(t for t in topics if t.startswith("failure_status"))
-    unknown = [t for t in gt if t not in _GROUND_TRUTH_TOPICS]
+    classes = _classes(flight)
+    unknown = [t for t in gt if t not in classes]
     if unknown:
         raise AlfaDataError(f"unknown ground-truth topic (known: "
                             f"{', '.join(_GROUND_TRUTH_TOPICS)})",
@@ -365,8 +391,8 @@ def _ground_truth(flight: str, label: str, topics: dict[str, Topic]) -> Fault | 
         raise AlfaDataError("labelled no_failure but has ground-truth rows",
                             flight=flight, file=f"{flight}-{gt[0]}.csv")
     order = list(_GROUND_TRUTH_TOPICS)
-    gt.sort(key=order.index)
-    _check_label(flight, label, {_GROUND_TRUTH_TOPICS[t] for t in gt}, gt)
+    gt.sort(key=lambda t: (order.index(t) if t in order else len(order), t))
+    _check_label(flight, label, {classes[t] for t in gt}, gt)
     codes = {t: tuple(dict.fromkeys(topics[t].values("field.data").astype(int).tolist()))
              for t in gt}
     first_gt = min(gt, key=lambda t: float(topics[t].t[0]))
@@ -381,7 +407,7 @@ def _ground_truth(flight: str, label: str, topics: dict[str, Topic]) -> Fault | 
                             flight=flight, file=f"{flight}-{first_gt}.csv", column="%time",
                             line=int(topics[first_gt].lines[0]))
     return Fault(
-        fault_class="+".join(_GROUND_TRUTH_TOPICS[t] for t in gt),
+        fault_class="+".join(classes[t] for t in gt),
         onset_s=onset,
         end_s=max(float(topics[t].t[-1]) for t in gt),
         topics=tuple(gt),

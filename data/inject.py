@@ -68,10 +68,12 @@ GROUND_TRUTH = "failure_status-sensor"
 
 def injected_name(source: str, sensor: str, kind: str, magnitude: float,
                   onset_s: float) -> str:
-    """The folder name of the flight :func:`inject_sensor_fault` writes."""
+    """The folder name of the flight :func:`inject_sensor_fault` writes (an ALFA
+    flight's or a converted log's, as its source)."""
     meta = parse_flight_name(source)
     size = "" if kind in ("stuck", "zero") else f"{round(100 * magnitude)}"
-    return (f"carbonZ_{meta['date']}-{meta['time']}_{meta['part'] or 0}_sensor_{sensor}_"
+    aircraft = source.split("_", 1)[0]
+    return (f"{aircraft}_{meta['date']}-{meta['time']}_{meta['part'] or 0}_sensor_{sensor}_"
             f"{kind}{size}_at{round(onset_s)}_failure")
 
 

@@ -5,8 +5,8 @@ Subsets (a flight may be in several):
 ``all``
     every flight with ground truth (a labelled fault, or ``no_failure``);
 ``icra22``
-    the 22 flights of Keipour et al., ICRA 2019: recorded up to 2018-09-11
-    inclusive, with ground truth, not ``with_emr_traj``;
+    the 22 flights of Keipour et al., ICRA 2019: ALFA's flights recorded up to
+    2018-09-11 inclusive, with ground truth, not ``with_emr_traj``;
 ``no_emr`` / ``emr``
     flights with ground truth without / with the emergency trajectory, whose
     commands change at the fault (reported apart, as the ALFA notes advise).
@@ -46,8 +46,8 @@ ICRA22_LAST_DATE = "2018-09-11"
 
 SUBSETS = {
     "all": lambda r: r["ground_truth"],
-    "icra22": lambda r: (r["ground_truth"] and r["date"] <= ICRA22_LAST_DATE
-                         and not r["emergency_trajectory"]),
+    "icra22": lambda r: (r["ground_truth"] and r["flight"].startswith("carbonZ_")
+                         and r["date"] <= ICRA22_LAST_DATE and not r["emergency_trajectory"]),
     "no_emr": lambda r: r["ground_truth"] and not r["emergency_trajectory"],
     "emr": lambda r: r["ground_truth"] and r["emergency_trajectory"],
 }
@@ -117,34 +117,36 @@ def name_subsets(flight: str) -> str:
         meta = parse_flight_name(flight)
     except AlfaDataError:
         return ""
-    row = {"ground_truth": meta["label"] != "no_ground_truth", "date": meta["date"],
+    row = {"flight": flight, "ground_truth": meta["label"] != "no_ground_truth",
+           "date": meta["date"],
            "emergency_trajectory": str(meta["label"]).endswith("with_emr_traj")}
     return ";".join(name for name, rule in SUBSETS.items() if rule(row))
 
 
-def _row(path: Path, cache: Path | None) -> dict:
+def _row(path: Path, cache: Path | None, signals=None) -> dict:
     flight = load_flight(path)
-    check_signals(flight)
+    check_signals(flight, signals)
     row = manifest_row(flight)
     if cache is not None:
         write_cached(flight, cache_path(cache, flight.id), row["sha256"])
     return row
 
 
-def scan_flights(processed: str | Path, cache: str | Path | None = None
+def scan_flights(processed: str | Path, cache: str | Path | None = None, signals=None
                  ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Load every flight under ``processed``: the validated manifest of those that
     load, and a failures table (:data:`~.errors.FAILURE_COLUMNS` and ``subsets``)
     of those that do not, each also logged. Every entry of ``processed`` but hidden
     ones is one or the other: one that is no flight folder (:func:`~.flight.
     not_a_flight`) is a failure saying why. With ``cache``, each flight that loads is
-    also written there (:mod:`.cache`)."""
+    also written there (:mod:`.cache`). ``signals`` are those checked
+    (:func:`~.signals.check_signals`; default the catalogue)."""
     rows, failures = [], []
     for path in entries(Path(processed)):
         try:
             if (why := not_a_flight(path)) is not None:
                 raise AlfaDataError(why, flight=path.name)
-            rows.append(_row(path, cache))
+            rows.append(_row(path, cache, signals))
         except AlfaDataError as e:
             log.error("flight %s excluded: %s", path.name, e)
             failures.append({**failure_row(e, "load"), "flight": path.name,
@@ -163,12 +165,13 @@ def manifest_of(rows: list[dict]) -> pd.DataFrame:
 
 
 def build_manifest(processed: str | Path, allow_empty: bool = False,
-                   cache: str | Path | None = None) -> pd.DataFrame:
+                   cache: str | Path | None = None, signals=None) -> pd.DataFrame:
     """Load every flight under ``processed`` and return the validated manifest;
     the first flight that cannot be read raises its :class:`AlfaDataError`. No flight
     at all is an error too, unless ``allow_empty`` (the injected grid of a corpus
-    without fault-free flights). With ``cache``, each flight is also written there."""
-    rows = [_row(p, cache) for p in find_flights(Path(processed))]
+    without fault-free flights). With ``cache``, each flight is also written there;
+    ``signals`` as for :func:`scan_flights`."""
+    rows = [_row(p, cache, signals) for p in find_flights(Path(processed))]
     if not rows and not allow_empty:
         raise AlfaDataError(f"no flights found under {processed}")
     return manifest_of(rows)

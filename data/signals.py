@@ -254,12 +254,13 @@ def reads_actuators(names) -> bool:
 
 
 def not_measured(flight: Flight, names=None) -> tuple[str, ...]:
-    """The sensors among ``names`` (default: every catalogue signal whose topic the
-    flight has) that are constant over the whole flight: not measured on it. A
+    """The sensors among ``names`` (default: every catalogue signal whose topic and
+    column the flight has) that are constant over the whole flight: not measured on it. A
     constant setpoint is a command that did not change, and a constant actuator an
     output not used; neither is missing data."""
     if names is None:
-        names = [n for n, sig in SIGNALS.items() if sig.topic in flight.topics]
+        names = [n for n, sig in SIGNALS.items() if sig.topic in flight.topics
+                 and sig.column in flight.topics[sig.topic].frame.columns]
     dead = []
     for name in (n for n in names if SIGNALS[n].kind == "sensor"):
         value = series(flight, name)[1]
@@ -268,25 +269,29 @@ def not_measured(flight: Flight, names=None) -> tuple[str, ...]:
     return tuple(dead)
 
 
-def check_signals(flight: Flight) -> None:
-    """Raise :class:`AlfaDataError` where any catalogue signal of ``flight`` could not
-    be read the way :func:`sample` reads it: a missing topic, a topic that does not
+def check_signals(flight: Flight, names=None) -> None:
+    """Raise :class:`AlfaDataError` where any of the signals ``names`` of ``flight``
+    (default: the whole catalogue; a corpus of logs, the signals it has) could not be
+    read the way :func:`sample` reads it: a missing topic, a topic that does not
     cover the flight, a gap of more than :data:`MAX_HOLD_S` between rows, a cell that
     is not a finite number, a value outside the signal's bounds (:func:`check_physical`).
     Called at load, so that a flight is refused for every run or read by all alike."""
-    for tp in dict.fromkeys(flight.topic(sig.topic) for sig in SIGNALS.values()):
+    names = list(SIGNALS) if names is None else list(names)
+    for tp in dict.fromkeys(flight.topic(SIGNALS[n].topic) for n in names):
         _check_coverage(flight, tp)
         _check_gaps(flight, tp)
-    for name in SIGNALS:
+    for name in names:
         series(flight, name)
-    check_physical(flight)
+    check_physical(flight, names)
 
 
-def check_physical(flight: Flight) -> None:
-    """Raise :class:`AlfaDataError` at the first value of a catalogue signal's column
-    outside its :attr:`Signal.bounds` (module docstring); a topic the flight lacks is
-    passed over (:func:`check_signals` refuses it)."""
-    for name, sig in SIGNALS.items():
+def check_physical(flight: Flight, names=None) -> None:
+    """Raise :class:`AlfaDataError` at the first value of a signal's column (of
+    ``names``, default the catalogue) outside its :attr:`Signal.bounds` (module
+    docstring); a topic the flight lacks is passed over (:func:`check_signals` refuses
+    it)."""
+    for name in SIGNALS if names is None else names:
+        sig = SIGNALS[name]
         if sig.bounds is None or sig.topic not in flight.topics:
             continue
         tp = flight.topics[sig.topic]

@@ -86,8 +86,8 @@ def _apart(table: pd.DataFrame) -> str:
     if not int(lead["tp"] + lead["fn"]):
         # a ranking of runs that had no fault to find says nothing of which finds faults
         return (f"<strong>No run can be told ahead:</strong> the {int(lead['flights'])} "
-                "flight(s) every ranked run scored hold no fault, so the ranks below "
-                "order false alarms alone.")
+                "flight(s) every ranked run scored hold no fault, so recall cannot be "
+                "computed and the ranks below order false alarms alone.")
     same = int(((table["rank"] > 1) & (table["vs_best_p"] >= SIGNIFICANCE)).sum())
     found = f"{int(lead['tp'])} of {int(lead['tp'] + lead['fn'])} faults in time"
     if not same:
@@ -164,11 +164,26 @@ def _left_out(left_out: pd.DataFrame, subset: str) -> str:
             f'out: {why} (why: <a href="tables/failures.csv">failures.csv</a>).</p>')
 
 
+def _not_applicable(not_applicable: dict[str, str]) -> str:
+    """The runs a corpus of logs cannot run, each with the signals it lacks, in a list."""
+    if not not_applicable:
+        return ""
+    items = "".join(f"<li><code>{html.escape(run)}</code>: reads {html.escape(why)}</li>"
+                    for run, why in not_applicable.items())
+    return (f"<h2>Not applicable to this corpus ({len(not_applicable)} runs)</h2>\n"
+            "<p class=\"note\">They read a signal the logs do not give "
+            "(<a href=\"corpus/signals.csv\">signals.csv</a>), so they were not run."
+            f"</p><ul class=\"note\">{items}</ul>")
+
+
 def index_html(comparison: pd.DataFrame, by_fault: pd.DataFrame, sweep_png: Path,
-               primary: str, run: str, left_out: pd.DataFrame, ceiling: pd.DataFrame) -> str:
+               primary: str, run: str, left_out: pd.DataFrame, ceiling: pd.DataFrame,
+               not_applicable: dict[str, str] | None = None,
+               data: str = "the ALFA flights") -> str:
     """The page (module docstring) from the run's ``comparison``, ``by_fault``,
     ``left_out`` and ``ceiling`` tables and its sweep figure; ``run`` names the run in
-    the footer."""
+    the footer, ``data`` the flights ranked; ``not_applicable`` (run -> the signals
+    it lacks) lists the runs a corpus of logs cannot run."""
     subset = comparison[comparison["subset"] == primary]
     table = subset[subset["rank"].notna()].sort_values("rank")
     d = fmt(float(comparison["deadline_s"].iloc[0]), digits=1)
@@ -209,7 +224,7 @@ def index_html(comparison: pd.DataFrame, by_fault: pd.DataFrame, sweep_png: Path
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>alfa-bench: results</title>
 <style>{_STYLE}</style></head><body>
-<h1>alfa-bench: online fault detectors on the ALFA flights</h1>
+<h1>alfa-bench: online fault detectors on {html.escape(data)}</h1>
 <p class="lead">{_apart(table)}</p>
 <p>Headline: subset <code>{html.escape(primary)}</code> ({flights}{note}), a fault
 detected when the first alarm comes at most {d} s after onset; {len(table)} honest runs
@@ -241,6 +256,7 @@ then recall, then mean detection time.{quiet} A detection is <em>stable</em> whe
 survives when the calibration flights are resampled (most of the resamples; "not
 resampled": thresholds that need a refit).</p>
 {_unranked(subset)}
+{_not_applicable(not_applicable or {})}
 <p class="note">Run {html.escape(run)}: code, packages, config, data and checksums in
 <code>results/provenance.json</code>.</p>
 </body></html>

@@ -50,7 +50,9 @@ from alfa_bench.render import Section, fmt, latex_tables, markdown
 __all__ = ["LEFT_OUT_COLUMNS", "SIGNIFICANCE", "SILENT", "by_fault_latex",
            "by_fault_markdown", "by_fault_table", "comparison_latex", "comparison_markdown",
            "common_ground", "comparison_notes", "comparison_table", "configurations",
-           "failures_table", "ground_note", "left_out_markdown",
+           "failures_table", "ground_note", "left_out_markdown", "no_fault_note",
+           "not_applicable_markdown",
+           "not_applicable_table",
            "refit_markdown", "stability_markdown", "summary_latex", "summary_markdown",
            "summary_table", "unscored_notes"]
 
@@ -624,6 +626,36 @@ def unscored_notes(comparison: pd.DataFrame, failures: pd.DataFrame, manifest: p
                          f"({stages}); `results/tables/failures.csv` says why and what to "
                          "change.")
     return "\n### Runs not scored\n\n" + "\n".join(lines) + "\n" if lines else ""
+
+
+def not_applicable_markdown(not_applicable: dict[str, str]) -> str:
+    """The runs a corpus of logs cannot run (``config["not_applicable"]``:
+    run -> the signals it reads that the corpus lacks, and why), in a section; empty
+    when there are none."""
+    if not not_applicable:
+        return ""
+    lines = [f"- `{run}`: reads {why}" for run, why in not_applicable.items()]
+    return ("\n### Runs not applicable to this corpus\n\nThey read a signal the corpus's "
+            "logs do not give (`results/corpus/signals.csv`), so they were not run; the "
+            "ranked runs' common ground is the same without them.\n\n"
+            + "\n".join(lines) + "\n")
+
+
+def no_fault_note(comparison: pd.DataFrame, primary: str) -> str:
+    """A line where no flight of the ``primary`` subset that the runs scored has a fault
+    (a corpus of fault-free logs): recall cannot be computed; empty otherwise."""
+    rows = comparison[comparison["subset"] == primary]
+    if not len(rows) or (rows["tp"] + rows["fn"]).max() > 0:
+        return ""
+    return (f"No flight of `{primary}` that the runs scored has a fault: recall cannot be "
+            "computed (`-`), and the ranks order false alarms alone.\n\n")
+
+
+def not_applicable_table(not_applicable: dict[str, str]) -> pd.DataFrame:
+    """``not_applicable`` as rows: ``method``, ``missing`` (the signals and why)."""
+    return pd.DataFrame([{"method": run, "missing": why}
+                         for run, why in not_applicable.items()],
+                        columns=["method", "missing"])
 
 
 def comparison_markdown(comparison: pd.DataFrame, unscored: str = "", primary: str | None = None,

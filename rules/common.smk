@@ -5,6 +5,8 @@ import shlex
 import sys
 from pathlib import Path
 
+import pandas as pd
+
 from snakemake.exceptions import WorkflowError
 from snakemake.logging import logger
 
@@ -20,6 +22,25 @@ from alfa_bench.outputs.provenance import RUN_FILE
 from alfa_bench.analysis.held_out import own_calibration
 from alfa_bench.data import SIGNALS, resolve_alfa_dir
 from alfa_bench.methods import detector_module, make_detector
+
+# a corpus of logs instead of ALFA (docs/own-flights.md): converted before the plan, its
+# not-applicable runs out of the config (workflow/corpus.py)
+CORPUS = config.get("corpus")
+if CORPUS:
+    from alfa_bench.logs.corpus import CorpusError, convert_corpus
+    from alfa_bench.workflow.corpus import CONVERTED, corpus_config, read_converted
+
+    try:
+        _converted = (convert_corpus(CORPUS, CONVERTED) if workflow.is_main_process
+                      else None)
+    except CorpusError as _e:
+        stop(f"config corpus: {_e}")
+    if _converted is not None and _converted.flights.empty:
+        stop(f"config corpus: no log of {CORPUS} could be read ({len(_converted.left_out)} "
+             f"left out): {CONVERTED / 'left_out.csv'} says why, by file, line and field")
+    corpus_config(config, _converted.signals if _converted else read_converted(),
+                  any(f.endswith("with_emr_traj") for f in pd.read_csv(
+                      CONVERTED / "flights.csv")["flight"]))
 
 METHODS = list(config["methods"])
 # the runs scored on the injected sensor faults and for isolation: the reference rows
@@ -109,12 +130,14 @@ def figure_fault_class(wildcards):
     return _fault_classes()[wildcards.flight]
 
 
-# ALFA_DIR, else the config's alfa_dir, else the downloaded archive.
-_alfa = resolve_alfa_dir(config.get("alfa_dir"))
+# the corpus's flights, else ALFA_DIR, else the config's alfa_dir, else the downloaded
+# archive
+_alfa = CONVERTED if CORPUS else resolve_alfa_dir(config.get("alfa_dir"))
 # who named the folder, for the messages that end a run on it
-ALFA_SOURCE = ("ALFA_DIR" if os.environ.get("ALFA_DIR") else
+ALFA_SOURCE = ("the config's corpus" if CORPUS else
+               "ALFA_DIR" if os.environ.get("ALFA_DIR") else
                "the config's alfa_dir" if _alfa is not None else "the download's dest")
-if _alfa is not None and (_why := alfa_dir_problem(_alfa, ALFA_SOURCE)):
+if not CORPUS and _alfa is not None and (_why := alfa_dir_problem(_alfa, ALFA_SOURCE)):
     stop(_why)
 DOWNLOAD = _alfa is None
 ALFA_DIR = Path(config["download"]["dest"]) if DOWNLOAD else _alfa
@@ -124,6 +147,7 @@ JOB_RESOURCES = job_resources(count_flights(PROCESSED))
 # where the flights came from, in every result's provenance (config is what it records)
 config["alfa_dir"] = str(ALFA_DIR)
 config["data_origin"] = (
+    f"corpus of logs: {CORPUS}" if CORPUS else
     f"downloaded: {config['download']['file']}, MD5 {config['download']['md5']}" if DOWNLOAD
     else "ALFA_DIR" if os.environ.get("ALFA_DIR") else "config alfa_dir")
 

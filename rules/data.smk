@@ -26,6 +26,8 @@ rule manifest:
     input:
         processed=PROCESSED,
         code=script_code("manifest"),
+        # a corpus's logs left out at conversion: failures like a flight that does not load
+        left_out=[CONVERTED / "left_out.csv"] if CORPUS else [],
     output:
         manifest="results/flights.csv",
         failures="results/load_failures.csv",
@@ -33,6 +35,8 @@ rule manifest:
         cache=directory("results/cache"),
     params:
         strict=config["strict"],
+        # the signals the data checks read: a corpus's own, else the whole catalogue
+        signals=[s for s, why in read_converted().items() if why is None] if CORPUS else None,
     resources:
         **JOB_RESOURCES,
     log:

@@ -37,11 +37,14 @@ rule tables:
         stability_md=report("results/tables/stability.md", caption="../report/stability.rst",
                             category="Comparison"),
         calibration="results/tables/calibration.csv",
+        # the runs a corpus of logs cannot run, with the signals it lacks (empty on ALFA)
+        not_applicable="results/tables/not_applicable.csv",
     params:
         subsets=SUBSETS,
         primary=PRIMARY,
         deadline_s=config["scoring"]["deadline_s"],
         stability=config["stability"],
+        not_applicable=config.get("not_applicable", {}),
     resources:
         **JOB_RESOURCES,
     log:
@@ -66,6 +69,9 @@ rule index_page:
         "results/index.html",
     params:
         primary=PRIMARY,
+        not_applicable=config.get("not_applicable", {}),
+        # what the page says it ranks: ALFA's flights, or the corpus of logs given
+        data=f"the logs of {CORPUS}" if CORPUS else "the ALFA flights",
     resources:
         **JOB_RESOURCES,
     log:

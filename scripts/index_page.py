@@ -14,4 +14,5 @@ prov = run_provenance(sm.config, read_manifest(sm.input.manifest))
 Path(sm.output[0]).write_text(index_html(
     read_table(sm.input.comparison), read_table(sm.input.by_fault), Path(sm.input.sweep),
     sm.params.primary, run_id(prov), read_table(sm.input.left_out),
-    read_table(sm.input.ceiling)))
+    read_table(sm.input.ceiling), not_applicable=sm.params.not_applicable,
+    data=sm.params.data))

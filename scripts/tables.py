@@ -21,6 +21,9 @@ from alfa_bench.outputs.tables import (
     comparison_table,
     failures_table,
     left_out_markdown,
+    no_fault_note,
+    not_applicable_markdown,
+    not_applicable_table,
     stability_markdown,
     summary_latex,
     summary_markdown,
@@ -64,9 +67,12 @@ audit = audit_note(read_table(sm.input.leakage), manifest, sm.params.primary,
                    failures[failures["stage"] == "load"])
 if audit.startswith("**WARNING"):
     logging.getLogger("alfa_bench.analysis").warning(audit.replace("*", "").strip())
+not_applicable_table(sm.params.not_applicable).to_csv(sm.output.not_applicable, index=False)
 Path(sm.output.comparison_md).write_text(comparison_markdown(
-    comparison, unscored_notes(comparison, failures, manifest, sm.params.subsets),
-    sm.params.primary, audit, left_out_markdown(left_out, sm.params.subsets)))
+    comparison, unscored_notes(comparison, failures, manifest, sm.params.subsets)
+    + not_applicable_markdown(sm.params.not_applicable),
+    sm.params.primary, no_fault_note(comparison, sm.params.primary) + audit,
+    left_out_markdown(left_out, sm.params.subsets)))
 Path(sm.output.comparison_html).write_text(markdown_html(
     Path(sm.output.comparison_md).read_text(), "alfa-bench: comparison"))
 Path(sm.output.summary_tex).write_text(summary_latex(summary))

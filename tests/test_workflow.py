@@ -649,7 +649,9 @@ def test_every_csv_reads_plainly_with_its_documented_header(runs):
     work = runs[0]
     found = sorted(p for p in (work / "results").rglob("*.csv")
                    if "detections" not in p.parts and "parts" not in p.parts)
-    assert {p.relative_to(work).as_posix() for p in found} == set(documented)
+    # results/corpus/ is written on a corpus of logs only (tests/test_own_flights.py)
+    assert {p.relative_to(work).as_posix() for p in found} == {
+        d for d in documented if not d.startswith("results/corpus/")}
     # a run's part of a table is its rows of it: the table's header
     parts = sorted((work / "results/parts").glob("*/*.csv"))
     assert {p.parent.name for p in parts} == {"sweep", "detectability", "isolation_sensors",
