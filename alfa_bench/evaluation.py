@@ -134,7 +134,9 @@ def load_corpus(alfa_dir: str | os.PathLike | None = None, *, config: dict | Non
     parsed once into ``cache`` (default: a folder per ALFA copy under the user's
     cache). A later call parses again only if a flight's files changed (their SHA-256
     is the manifest's key). ``config`` is a config dict (default: the one the package
-    ships, :func:`~alfa_bench.config.load_config`)."""
+    ships, :func:`~alfa_bench.config.load_config`). A corpus of logs the workflow
+    converted (``alfa_dir="results/corpus"``, docs/own-flights.md) is checked on the
+    signals it has."""
     config = load_config() if config is None else config
     if alfa_dir is not None:
         found, source = Path(alfa_dir), f"load_corpus(alfa_dir={str(alfa_dir)!r})"
@@ -158,7 +160,13 @@ def load_corpus(alfa_dir: str | os.PathLike | None = None, *, config: dict | Non
                 and set(now) == set(known) | set(failures["flight"])):
             return Corpus(processed, manifest, failures, config, cache)
         log.info("%s changed since it was cached: parsing it again", processed)
-    manifest, failures = scan_flights(processed, cache=cache)
+    # a corpus of logs converted by the workflow (results/corpus): its own signals
+    signals = None
+    if (processed.parent / "signals.csv").is_file():
+        from alfa_bench.logs.corpus import read_signals
+
+        signals = [s for s, why in read_signals(processed.parent).items() if why is None]
+    manifest, failures = scan_flights(processed, cache=cache, signals=signals)
     manifest.to_csv(manifest_csv, index=False)
     failures.to_csv(failures_csv, index=False)
     # read back, as every workflow job reads results/flights.csv

@@ -12,6 +12,9 @@ run's, for every run the MAVLink map carries the signals of.
   temporary folder).
 - ``--leader RUN``: the run the goal is stated on (default: the ALFA run's first ranked
   run on the headline subset).
+- ``--values-only``: also the ALFA flights with each mapped column's values replaced by
+  what the link carried (read back from the logs) at ALFA's own row times, scored as
+  ALFA: which differences the values alone make, and which the logs' row times.
 
 Prints, per run, the flights both scored and how many outcomes agree, then every
 differing outcome with both first alarms. A flight's name differs between the two
@@ -32,12 +35,14 @@ import pandas as pd
 REPO = Path(__file__).resolve().parents[1]
 
 
-def snakemake(workdir: Path, *config: str) -> None:
+def snakemake(workdir: Path, *config: str, alfa_dir: Path | None = None) -> None:
+    """``snakemake all`` in ``workdir`` (on ``alfa_dir`` where given, else ``ALFA_DIR``)."""
+    env = {**os.environ, **({"ALFA_DIR": str(alfa_dir)} if alfa_dir else {})}
     cmd = [sys.executable, "-m", "snakemake", "all", "--cores", "2", "--quiet",
            "--snakefile", str(REPO / "Snakefile"), "--directory", str(workdir),
            "--configfile", str(REPO / "config/config.yaml"),
            *(["--config", *config] if config else [])]
-    subprocess.run(cmd, check=True)
+    subprocess.run(cmd, check=True, env=env)
 
 
 def write_logs(alfa_results: Path, logs: Path) -> None:
@@ -61,6 +66,43 @@ def write_logs(alfa_results: Path, logs: Path) -> None:
     pd.DataFrame(rows).to_csv(logs / "labels.csv", index=False)
 
 
+def write_values_only(alfa_results: Path, corpus_results: Path, out: Path) -> None:
+    """The ALFA flights under ``out/processed``, each column the link carries holding
+    the value read back from the flight's log at each ALFA row time (1 µs of slack for
+    the log's stamps), every other column and every row time as ALFA has them."""
+    import shutil
+
+    import numpy as np
+
+    from alfa_bench.data import SIGNALS
+
+    names = pd.read_csv(corpus_results / "corpus/flights.csv")
+    processed = Path(os.environ["ALFA_DIR"]) / "processed"
+    for log, flight in zip(names["log"], names["flight"], strict=True):
+        name = log.removesuffix(".tlog")
+        target = out / "processed" / name
+        shutil.copytree(processed / name, target, dirs_exist_ok=True)
+        converted = corpus_results / "corpus/processed" / flight
+        origin = int(pd.read_csv(converted / f"{flight}-log-origin.csv")["%time"].iloc[0])
+        for topic in {sig.topic for sig in SIGNALS.values()}:
+            mine = converted / f"{flight}-{topic}.csv"
+            if not mine.is_file():
+                continue
+            theirs = target / f"{name}-{topic}.csv"
+            frame = pd.read_csv(theirs, dtype={"%time": "int64"})
+            link = pd.read_csv(mine, dtype={"%time": "int64"})
+            t0 = min(int(pd.read_csv(p, usecols=["%time"], dtype="int64")["%time"].iloc[0])
+                     for p in (processed / name).glob("*.csv"))
+            at = (frame["%time"].to_numpy() - t0) + origin + 1000
+            row = np.searchsorted(link["%time"].to_numpy(), at, side="right") - 1
+            ok = row >= 0
+            for column in link.columns[1:]:
+                values = frame[column].to_numpy(dtype=float, copy=True)
+                values[ok] = link[column].to_numpy()[row[ok]]
+                frame[column] = values
+            frame.to_csv(theirs, index=False)
+
+
 def compare(alfa_results: Path, corpus_results: Path) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Per run, the flights both scored and the outcomes that agree; and the rows that
     differ."""
@@ -79,11 +121,18 @@ def compare(alfa_results: Path, corpus_results: Path) -> tuple[pd.DataFrame, pd.
     return per_run, diff
 
 
+def _outcomes(results: Path) -> pd.DataFrame:
+    table = pd.read_csv(results / "tables/per_flight.csv")
+    return table[["method", "flight", "outcome", "first_alarm_s"]].rename(
+        columns={"outcome": "outcome_values", "first_alarm_s": "first_alarm_s_values"})
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--alfa-run", type=Path)
     parser.add_argument("--work", type=Path)
     parser.add_argument("--leader")
+    parser.add_argument("--values-only", action="store_true")
     args = parser.parse_args()
     work = args.work or Path(tempfile.mkdtemp(prefix="round_trip"))
     alfa = args.alfa_run
@@ -93,8 +142,19 @@ def main() -> None:
         alfa = work / "alfa/results"
     write_logs(alfa, work / "logs")
     (work / "corpus").mkdir(parents=True, exist_ok=True)
-    snakemake(work / "corpus", f"corpus={work / 'logs'}")
+    if not (work / "corpus/results/tables/per_flight.csv").is_file():
+        snakemake(work / "corpus", f"corpus={work / 'logs'}")
     per_run, diff = compare(alfa, work / "corpus/results")
+    if args.values_only:
+        values = work / "values"
+        write_values_only(alfa, work / "corpus/results", values / "alfa")
+        (values / "run").mkdir(parents=True, exist_ok=True)
+        snakemake(values / "run", alfa_dir=values / "alfa")
+        both = diff.merge(_outcomes(values / "run/results"), on=["method", "flight"],
+                          how="left")
+        print("\nthe differing outcomes, with the ALFA flights holding the link's values at "
+              "ALFA's row times:")
+        print(both.to_string(index=False))
     comparison = pd.read_csv(alfa / "tables/comparison.csv")
     primary = comparison["subset"].iloc[0]
     ranked = comparison[(comparison["subset"] == primary) & comparison["rank"].notna()]

@@ -27,8 +27,8 @@ from alfa_bench.methods import detector_module, make_detector
 # not-applicable runs out of the config (workflow/corpus.py)
 CORPUS = config.get("corpus")
 if CORPUS:
-    from alfa_bench.logs.corpus import CorpusError, convert_corpus
-    from alfa_bench.workflow.corpus import CONVERTED, corpus_config, read_converted
+    from alfa_bench.logs.corpus import CorpusError, convert_corpus, read_signals
+    from alfa_bench.workflow.corpus import CONVERTED, corpus_config
 
     try:
         _converted = (convert_corpus(CORPUS, CONVERTED) if workflow.is_main_process
@@ -38,7 +38,7 @@ if CORPUS:
     if _converted is not None and _converted.flights.empty:
         stop(f"config corpus: no log of {CORPUS} could be read ({len(_converted.left_out)} "
              f"left out): {CONVERTED / 'left_out.csv'} says why, by file, line and field")
-    corpus_config(config, _converted.signals if _converted else read_converted(),
+    corpus_config(config, _converted.signals if _converted else read_signals(CONVERTED),
                   any(f.endswith("with_emr_traj") for f in pd.read_csv(
                       CONVERTED / "flights.csv")["flight"]))
 

@@ -36,7 +36,7 @@ rule manifest:
     params:
         strict=config["strict"],
         # the signals the data checks read: a corpus's own, else the whole catalogue
-        signals=[s for s, why in read_converted().items() if why is None] if CORPUS else None,
+        signals=[s for s, why in read_signals(CONVERTED).items() if why is None] if CORPUS else None,
     resources:
         **JOB_RESOURCES,
     log:

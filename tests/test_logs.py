@@ -229,3 +229,26 @@ def test_a_ulog_corpus_has_the_signals_every_log_gives(tmp_path):
     assert "1 of 2 logs" in corpus.signals["throttle"]
     manifest = build_manifest(corpus.processed, signals=corpus.has)
     assert list(manifest["date"]) == ["a", "b"] and (manifest["fault_class"] == "none").all()
+
+
+def test_the_guide_tabulates_every_entry_of_each_map():
+    """docs/own-flights.md lists each entry of the DataFlash and ULog maps, and each
+    signal they cannot give, as the code has them."""
+    from alfa_bench.logs import dataflash, ulog
+
+    text = (Path(__file__).resolve().parents[1] / "docs/own-flights.md").read_text()
+    for module in (dataflash, ulog):
+        for e in module.MAP:
+            fields = ", ".join(f"`{f}`" for f in e.fields)
+            row = (f"| `{e.message}` | {fields} | {e.how} | `{e.signal}` | "
+                   f"{SIGNALS[e.signal].kind} |")
+            assert row in text, row
+        for signal, why in module.NOT_GIVEN.items():
+            assert f"| `{signal}` | {why} |" in text, signal
+
+
+def test_the_python_route_reads_a_converted_corpus(converted, tmp_path):
+    import alfa_bench as ab
+
+    corpus = ab.load_corpus(converted.processed.parent, cache=tmp_path / "cache")
+    assert corpus.failures.empty and len(corpus.flights) == 6

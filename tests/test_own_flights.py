@@ -83,3 +83,5 @@ def test_the_corpus_files_read_with_their_documented_header(ulog_run):
     for name, header in documented.items():
         frame = pd.read_csv(results.parent / name)
         assert list(frame.columns) == re.findall(r"`([^`]+)`", header), name
+    converted = sorted((results / "corpus/processed").iterdir())
+    assert len(converted) == 5 and all(p.name.startswith("log_g") for p in converted)

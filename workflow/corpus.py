@@ -15,9 +15,7 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-import pandas as pd
-
-__all__ = ["CONVERTED", "corpus_config", "not_applicable", "read_converted"]
+__all__ = ["CONVERTED", "corpus_config", "not_applicable"]
 
 log = logging.getLogger(__name__)
 
@@ -37,12 +35,6 @@ def not_applicable(methods: dict, signals: dict[str, str | None]) -> dict[str, s
         if missing:
             out[run] = "; ".join(f"{s} ({signals[s]})" for s in missing)
     return out
-
-
-def read_converted(folder: Path = CONVERTED) -> dict[str, str | None]:
-    """The signals of the corpus converted into ``folder`` (its ``signals.csv``)."""
-    table = pd.read_csv(folder / "signals.csv", keep_default_na=False)
-    return {r.signal: None if r.given else r.why_not for r in table.itertuples()}
 
 
 def corpus_config(config: dict, signals: dict[str, str | None], emr: bool) -> None:

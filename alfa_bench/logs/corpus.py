@@ -63,7 +63,7 @@ from alfa_bench.live import mavlink
 from .records import LogRecords
 
 __all__ = ["ALFA_FAULTS", "CorpusError", "LEFT_OUT_COLUMNS", "LogCorpus", "convert_corpus",
-           "read_labels", "read_log"]
+           "read_labels", "read_log", "read_signals"]
 
 log = logging.getLogger("alfa_bench.logs")
 
@@ -258,6 +258,13 @@ def convert_corpus(folder: str | Path, out: str | Path) -> LogCorpus:
                  ).to_csv(out / "signals.csv", index=False)
     left.to_csv(out / "left_out.csv", index=False)
     return LogCorpus(processed, flights, signals, left)
+
+
+def read_signals(out: str | Path) -> dict[str, str | None]:
+    """The signals of the corpus converted into ``out`` (its ``signals.csv``): signal ->
+    why the corpus lacks it, None where it has it."""
+    table = pd.read_csv(Path(out) / "signals.csv", keep_default_na=False)
+    return {r.signal: None if r.given else r.why_not for r in table.itertuples()}
 
 
 def _corpus_signals(gives: list[dict[str, str | None]], logs: list[str]
