@@ -252,3 +252,15 @@ def test_the_python_route_reads_a_converted_corpus(converted, tmp_path):
 
     corpus = ab.load_corpus(converted.processed.parent, cache=tmp_path / "cache")
     assert corpus.failures.empty and len(corpus.flights) == 6
+
+
+def test_the_tlog_entries_convert_as_the_monitors_map():
+    from alfa_bench.live import mavlink
+    from alfa_bench.logs import tlog
+
+    fields = {"direction": 200.0, "speed": 4.0, **{f.field: 3.5 for f in
+                                                    mavlink.FIELDS.values()}}
+    for e in tlog.MAP:
+        decoded = mavlink.decode(e.message, fields.__getitem__)
+        got = float(e.convert(*(np.asarray(fields[f]) for f in e.fields)))
+        assert got == pytest.approx(decoded[e.signal]), e.signal

@@ -1,7 +1,8 @@
 """An ALFA flight written as the MAVLink messages the map reads, at its logged times.
 
 Each message type of :data:`.mavlink.MESSAGES` is sent at every row time of the topics
-its signals come from, once all of those topics have begun, carrying each signal's
+its signals come from, from when all of those topics have begun until the first of them
+ends (so that no signal is carried beyond its topic's span), carrying each signal's
 value held at that time (its topic's last row at or before it): a monitor that holds
 each signal by zero-order hold (:func:`alfa_bench.data.hold`) sees on the grid the
 values and freshness the data layer samples from the flight. Messages whose fields
@@ -56,8 +57,9 @@ def messages(flight: Flight, signals=None) -> Iterator[tuple[float, str, dict]]:
             continue
         topics = {SIGNALS[n].topic for n in names}
         start = max(float(flight.topic(tp).t[0]) for tp in topics)
+        stop = min(float(flight.topic(tp).t[-1]) for tp in topics)
         times = np.unique(np.concatenate([flight.topic(tp).t for tp in topics]))
-        times = times[times >= start]
+        times = times[(times >= start) & (times <= stop)]
         held = {}
         for n in names:
             t, v = series(flight, n)

@@ -11,18 +11,22 @@ error against it.
 
 from __future__ import annotations
 
+import numpy as np
+
 from alfa_bench.live import mavlink
 
 from .records import Entry, LogRecords, check_map, collect, linear
 
 __all__ = ["MAP", "NOT_GIVEN", "read"]
 
-#: the monitor's map as entries (the wind's two signals from its direction and speed)
+#: the monitor's map as entries (the wind's two signals from its direction and speed),
+#: which name what gives each signal; the values are read by the map itself
+#: (:func:`alfa_bench.live.mavlink.decode`)
 MAP = [*(linear(f.signal, f.message, f.field, f.unit, f.gain) for f in mavlink.FIELDS.values()),
        Entry("wind_north", "WIND", ("direction", "speed"), "deg, m/s",
-             "−speed × cos(direction)", None),
+             "−speed × cos(direction)", lambda d, v: -np.asarray(v) * np.cos(np.radians(d))),
        Entry("wind_east", "WIND", ("direction", "speed"), "deg, m/s",
-             "−speed × sin(direction)", None)]
+             "−speed × sin(direction)", lambda d, v: -np.asarray(v) * np.sin(np.radians(d)))]
 
 NOT_GIVEN = {"airspeed_cmd": "no MAVLink message carries the commanded airspeed; "
                              "NAV_CONTROLLER_OUTPUT gives only the error against it"}
