@@ -1,10 +1,9 @@
 """The README's first command on a corpus of logs none of us recorded: PX4's own ULogs
 (../shared/logs/px4, fault-free multicopter flights) with a labels.csv and one broken
-log, through `snakemake all --config corpus=...`."""
+log, through the workflow with `--config corpus=...` to its tables and page."""
 
 from __future__ import annotations
 
-import json
 import re
 import shutil
 from pathlib import Path
@@ -20,8 +19,10 @@ PX4 = Path(__file__).resolve().parents[2] / "shared" / "logs" / "px4"
 @pytest.fixture(scope="module")
 def ulog_run(tmp_path_factory):
     require_module("pyulog")
-    logs = sorted(PX4.glob("*.ulg"))
-    if len(logs) < 5:
+    # three of the five: enough for folds, a run ranked and the gaps between logs
+    logs = [PX4 / n for n in ("sample.ulg", "sample_logging_tagged_and_default_params.ulg",
+                              "sample_px4_events.ulg")]
+    if not all(p.is_file() for p in logs):
         unavailable(f"PX4's sample ULogs are not at {PX4}")
     root = tmp_path_factory.mktemp("own")
     corpus = root / "logs"
@@ -35,7 +36,10 @@ def ulog_run(tmp_path_factory):
                  ).to_csv(corpus / "labels.csv", index=False)
     work = root / "run"
     work.mkdir()
-    done = run_workflow(work, None, "--config", f"corpus={corpus}")
+    # the tables and the page: what this file checks (the paper, recordings and figures
+    # are the ALFA runs' tests')
+    done = run_workflow(work, None, "--config", f"corpus={corpus}",
+                        target=["results/index.html", "results/tables/comparison.md"])
     return work / "results", done
 
 
@@ -48,8 +52,7 @@ def test_a_ulog_corpus_runs_through_with_a_run_ranked(ulog_run):
     assert (primary["tp"] + primary["fn"]).max() == 0
     assert "recall cannot be computed" in (results / "tables/comparison.md").read_text()
     assert "recall cannot be computed" in (results / "index.html").read_text()
-    provenance = json.loads((results / "provenance.json").read_text())
-    assert "corpus of logs" in json.dumps(provenance)
+    assert "the logs of" in (results / "index.html").read_text()
 
 
 def test_runs_needing_signals_a_multicopter_lacks_are_named(ulog_run):
@@ -68,10 +71,10 @@ def test_runs_needing_signals_a_multicopter_lacks_are_named(ulog_run):
 def test_a_broken_log_is_left_out_and_named_not_a_stopped_run(ulog_run):
     results, _ = ulog_run
     left = pd.read_csv(results / "corpus/left_out.csv")
-    assert list(left["log"]) == ["cut.ulg"] and left["line"].tolist() == [7]
+    assert list(left["log"]) == ["cut.ulg"] and left["line"].tolist() == [5]
     failures = pd.read_csv(results / "load_failures.csv")
     assert "cut.ulg" in set(failures["flight"])
-    assert len(pd.read_csv(results / "flights.csv")) == 5
+    assert len(pd.read_csv(results / "flights.csv")) == 3
 
 
 def test_the_corpus_files_read_with_their_documented_header(ulog_run):
@@ -84,4 +87,4 @@ def test_the_corpus_files_read_with_their_documented_header(ulog_run):
         frame = pd.read_csv(results.parent / name)
         assert list(frame.columns) == re.findall(r"`([^`]+)`", header), name
     converted = sorted((results / "corpus/processed").iterdir())
-    assert len(converted) == 5 and all(p.name.startswith("log_g") for p in converted)
+    assert len(converted) == 3 and all(p.name.startswith("log_g") for p in converted)

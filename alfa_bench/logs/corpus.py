@@ -225,9 +225,9 @@ def convert_corpus(folder: str | Path, out: str | Path) -> LogCorpus:
     converted, gives = [], []
     for row in rows:
         path = folder / row["log"]
-        key = {"sha256": _file_sha256(path), "readers": readers,
-               "row": {k: v for k, v in row.items() if k != "line"}}
         try:
+            key = {"sha256": _file_sha256(path), "readers": readers,
+                   "row": {k: v for k, v in row.items() if k != "line"}}
             flight, given = _convert_once(path, row, key, processed)
         except CorpusError:
             raise
