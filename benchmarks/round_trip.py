@@ -15,8 +15,6 @@ run's, for every run the MAVLink map carries the signals of.
 - ``--values-only``: also the ALFA flights with each mapped column's values replaced by
   what the link carried (read back from the logs) at ALFA's own row times, scored as
   ALFA: which differences the values alone make, and which the logs' row times.
-- ``--stamps``: as ``--values-only``, every row time also rounded to the µs as a log
-  stamps it: which differences the µs stamps make.
 
 Prints, per run, the flights both scored and how many outcomes agree, then every
 differing outcome with both first alarms. A flight's name differs between the two
@@ -68,12 +66,10 @@ def write_logs(alfa_results: Path, logs: Path) -> None:
     pd.DataFrame(rows).to_csv(logs / "labels.csv", index=False)
 
 
-def write_values_only(alfa_results: Path, corpus_results: Path, out: Path,
-                      stamps: bool = False) -> None:
+def write_values_only(alfa_results: Path, corpus_results: Path, out: Path) -> None:
     """The ALFA flights under ``out/processed``, each column the link carries holding
     the value read back from the flight's log at each ALFA row time (1 µs of slack for
-    the log's stamps), every other column and every row time as ALFA has them; with
-    ``stamps``, every row time then rounded to the µs, as a log stamps it."""
+    the log's stamps), every other column and every row time as ALFA has them."""
     import shutil
 
     import numpy as np
@@ -105,14 +101,6 @@ def write_values_only(alfa_results: Path, corpus_results: Path, out: Path,
                 values[ok] = link[column].to_numpy()[row[ok]]
                 frame[column] = values
             frame.to_csv(theirs, index=False)
-        if stamps:
-            t0 = min(int(pd.read_csv(p, usecols=["%time"], dtype="int64")["%time"].iloc[0])
-                     for p in target.glob("*.csv"))
-            for path in target.glob("*.csv"):
-                frame = pd.read_csv(path, dtype={"%time": "int64"})
-                rel = frame["%time"].to_numpy() - t0
-                frame["%time"] = t0 + np.round(rel / 1000).astype("int64") * 1000
-                frame.to_csv(path, index=False)
 
 
 def compare(alfa_results: Path, corpus_results: Path) -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -145,7 +133,6 @@ def main() -> None:
     parser.add_argument("--work", type=Path)
     parser.add_argument("--leader")
     parser.add_argument("--values-only", action="store_true")
-    parser.add_argument("--stamps", action="store_true")
     args = parser.parse_args()
     work = args.work or Path(tempfile.mkdtemp(prefix="round_trip"))
     alfa = args.alfa_run
@@ -158,15 +145,15 @@ def main() -> None:
     if not (work / "corpus/results/tables/per_flight.csv").is_file():
         snakemake(work / "corpus", f"corpus={work / 'logs'}")
     per_run, diff = compare(alfa, work / "corpus/results")
-    if args.values_only or args.stamps:
-        values = work / ("stamps" if args.stamps else "values")
-        write_values_only(alfa, work / "corpus/results", values / "alfa", args.stamps)
+    if args.values_only:
+        values = work / "values"
+        write_values_only(alfa, work / "corpus/results", values / "alfa")
         (values / "run").mkdir(parents=True, exist_ok=True)
         snakemake(values / "run", alfa_dir=values / "alfa")
         both = diff.merge(_outcomes(values / "run/results"), on=["method", "flight"],
                           how="left")
         print("\nthe differing outcomes, with the ALFA flights holding the link's values at "
-              f"ALFA's row times{', rounded to the µs' if args.stamps else ''}:")
+              "ALFA's row times:")
         print(both.to_string(index=False))
     comparison = pd.read_csv(alfa / "tables/comparison.csv")
     primary = comparison["subset"].iloc[0]
