@@ -153,6 +153,11 @@ class Topic:
     def frame(self) -> pd.DataFrame:
         return self._frame() if callable(self._frame) else self._frame
 
+    def has(self, column: str) -> bool:
+        """Whether the topic has ``column``; a column already parsed to numbers builds no
+        frame to say so."""
+        return column in self._cache or column in self.frame.columns
+
     def values(self, column: str) -> np.ndarray:
         """Return ``column`` as float64, checked to be finite in every row."""
         if column in self._cache:

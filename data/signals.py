@@ -260,7 +260,7 @@ def not_measured(flight: Flight, names=None) -> tuple[str, ...]:
     output not used; neither is missing data."""
     if names is None:
         names = [n for n, sig in SIGNALS.items() if sig.topic in flight.topics
-                 and sig.column in flight.topics[sig.topic].frame.columns]
+                 and flight.topics[sig.topic].has(sig.column)]
     dead = []
     for name in (n for n in names if SIGNALS[n].kind == "sensor"):
         value = series(flight, name)[1]
