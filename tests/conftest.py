@@ -26,6 +26,16 @@ def pytest_report_header(config):
             "flights are SKIPPED ***")
 
 
+@pytest.hookimpl(tryfirst=True, optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """The workers' share of the suite (tests/scheduling.py), for ``--dist loadgroup``."""
+    if config.getvalue("dist") == "loadgroup":
+        from scheduling import SharedRunsScheduling
+
+        return SharedRunsScheduling(config, log)
+    return None
+
+
 def pytest_collection_modifyitems(items):
     # the contract of each config run: the registry's checks again, with its parameters
     for item in items:
