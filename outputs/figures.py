@@ -50,6 +50,19 @@ def colors(methods) -> dict[str, tuple]:
     return {m: cmap(i) if i < 10 else more(4 * (i - 10) % 20) for i, m in enumerate(methods)}
 
 
+def _grid_in_inches(fig, rows: int, cols: int, *, left: float, right: float, top: float,
+                    bottom: float, between_rows: float, between_cols: float) -> None:
+    """Place a grid of axes with its margins and gaps in inches: what a constrained
+    layout would find, without its solver, whose cost grows with the axes (about 4 s
+    for one panel per run)."""
+    width, height = fig.get_size_inches()
+    axes_h = (height - top - bottom - between_rows * (rows - 1)) / rows
+    axes_w = (width - left - right - between_cols * (cols - 1)) / cols
+    fig.subplots_adjust(left=left / width, right=1 - right / width, top=1 - top / height,
+                        bottom=bottom / height, hspace=between_rows / axes_h,
+                        wspace=between_cols / axes_w)
+
+
 def save(fig, path: str | Path) -> None:
     """Write ``fig`` as a deterministic PNG and close it."""
     Path(path).parent.mkdir(parents=True, exist_ok=True)
@@ -145,8 +158,11 @@ def detection_time_figure(records: list[dict], flights: list[str], deadline_s: f
         r["fault_class"] == c and r["flight"] in keep for r in records)]
     cols = min(4, len(methods))
     rows = -(-len(methods) // cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(3.6 * cols, 3.0 * rows), squeeze=False,
-                             sharey=True, layout="constrained")
+    # one y-axis set on each panel alike, not shared: a shared axis propagates each
+    # change to every other panel, which costs seconds over one panel per run
+    fig, axes = plt.subplots(rows, cols, figsize=(3.6 * cols, 3.0 * rows), squeeze=False)
+    _grid_in_inches(fig, rows, cols, left=0.65, right=0.4, top=0.55, bottom=0.75,
+                    between_rows=1.05, between_cols=0.35)
     late_at = 1.12 * deadline_s
     for ax, m in zip(axes.flat, methods, strict=False):
         recs = [r for r in records if r["method"] == m and r["flight"] in keep]
@@ -170,14 +186,17 @@ def detection_time_figure(records: list[dict], flights: list[str], deadline_s: f
         ax.grid(alpha=0.3, axis="y")
     for ax in axes.flat[len(methods):]:
         ax.set_visible(False)
-    for ax in axes[:, 0]:
+    ticks = list(np.arange(0, deadline_s + 1e-9, 1.0))
+    for i, ax in enumerate(axes.flat[:len(methods)]):
         ax.set_ylim(0, 1.2 * deadline_s)
-        ticks = list(np.arange(0, deadline_s + 1e-9, 1.0))
         ax.set_yticks([*ticks, late_at], [f"{t:g}" for t in ticks] + ["late"])
+        ax.tick_params(labelleft=i % cols == 0)
+    for ax in axes[:, 0]:
         ax.set_ylabel("detection time (s)")
     fig.suptitle(f"Detection time by fault class, scored with the {deadline_s:g} s deadline "
                  "(bar = median; label = detected in time / flights, + late: x, detected "
-                 "by the paper's rule only)", fontsize=9)
+                 "by the paper's rule only)", fontsize=9, y=1 - 0.12 / fig.get_figheight(),
+                 va="top")
     save(fig, path)
 
 
@@ -187,7 +206,10 @@ def deadline_figure(table: pd.DataFrame, subset: str, path: str | Path) -> None:
     data = table[table["subset"] == subset]
     methods = list(dict.fromkeys(data["method"]))
     palette = colors(methods)
-    fig, ax = plt.subplots(figsize=(8.5, 5.0), layout="constrained")
+    # the legend below the axes, two runs a line: inside them, one line a run hid the
+    # curves once the field outgrew a dozen runs
+    fig, ax = plt.subplots(figsize=(8.5, 4.5 + 0.15 * -(-len(methods) // 2)),
+                           layout="constrained")
     for m in methods:
         d = data[data["method"] == m].sort_values("deadline_s")
         style = BLOCK_STYLES[d["block"].iloc[0]]
@@ -199,7 +221,8 @@ def deadline_figure(table: pd.DataFrame, subset: str, path: str | Path) -> None:
     ax.set_ylabel("faults detected within the deadline (share)")
     ax.set_ylim(-0.02, 1.02)
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7, loc="upper left")
+    if methods:
+        fig.legend(fontsize=7, loc="outside lower center", ncols=2)
     n = int(data["fault_flights"].iloc[0]) if len(data) else 0
     ax.set_title(f"Detection rate against deadline, subset '{subset}' ({n} fault flights)",
                  fontsize=10)
