@@ -65,7 +65,6 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 from numpy.lib.stride_tricks import sliding_window_view
-from scipy.stats import binom
 
 from alfa_bench.data import (
     SIGNALS,
@@ -179,6 +178,10 @@ def _command_part(flight: Flight, name: str) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _verdict_p(k: int, n: int, p0: float) -> float:
+    # here: the tables, index page and paper read the audit's note, not its test, and
+    # scipy.stats would cost each of them a second to import
+    from scipy.stats import binom
+
     return float(binom.sf(k - 1, n, p0)) if n else math.nan
 
 
