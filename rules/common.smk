@@ -14,6 +14,7 @@ from alfa_bench.workflow.preflight import alfa_dir_problem, failure_message, sto
 from alfa_bench.workflow import forkserver
 from alfa_bench.workflow.dependencies import module_sources, script_sources
 from alfa_bench.workflow.detect_job import SERVER_ENV, write_job_config
+from alfa_bench.workflow.param_checks import KeptChecks
 from alfa_bench.workflow.parts_job import SERVER_ENV as PARTS_SERVER_ENV
 from alfa_bench.workflow.logs import closing_lines
 from alfa_bench.workflow.stale import remove, stale_results
@@ -60,11 +61,12 @@ INJECTED_PROCESSED = "results/injected/processed"
 # the schema checks the config's shape; each method's detector and parameter names are
 # checked against the registry here, before any job runs, by the process that plans the
 # run: a cluster job's process, which parses the workflow again, imports no detector
+_checks = KeptChecks()
 for _name, _spec in config["methods"].items() if workflow.is_main_process else ():
     try:
         _detector = make_detector(_spec["detector"], _spec.get("params"))
-        # a library's model by name, imported
-        _detector.check_params()
+        # a library's model by name, imported; a check passed before is not made again
+        _checks.check(_spec, _detector.check_params)
     except (KeyError, TypeError, ValueError) as _e:
         raise WorkflowError(f"config methods.{_name}: {_e}") from None
     # a misspelt signal is the config's error, not every flight's bad data
@@ -81,6 +83,8 @@ for _name, _spec in config["methods"].items() if workflow.is_main_process else (
         raise WorkflowError(f"config methods.{_name}: calibration.group_by: {_grouping} lets "
                             "flights of the scored date train it, so it can only be a "
                             "reference row (role: reference)")
+if workflow.is_main_process:
+    _checks.save()
 
 
 # what a run taken out of the config left: named once, removed on request

@@ -1,0 +1,102 @@
+"""The config's checks of each run's parameters, kept between runs (workflow/param_checks.py)."""
+
+import json
+
+import pytest
+
+from alfa_bench.workflow import param_checks
+from alfa_bench.workflow.param_checks import KeptChecks, run_key
+
+SPEC = {"detector": "pyod", "params": {"model": "KNN", "false_alarm": 0.1}}
+
+
+class Calls:
+    def __init__(self, error=None):
+        self.n, self.error = 0, error
+
+    def __call__(self):
+        self.n += 1
+        if self.error:
+            raise self.error
+
+
+def test_a_passed_check_is_not_made_again_and_a_changed_run_is(tmp_path):
+    path = tmp_path / "checks.json"
+    first = KeptChecks(path)
+    calls = Calls()
+    first.check(SPEC, calls)
+    first.save()
+    assert calls.n == 1 and first.made_ == 1
+    again = KeptChecks(path)
+    again.check(SPEC, calls)
+    assert calls.n == 1 and again.made_ == 0
+    changed = {**SPEC, "params": {**SPEC["params"], "false_alarm": 0.05}}
+    again.check(changed, calls)
+    assert calls.n == 2
+    again.save()
+    # only the runs of this config are kept
+    assert sorted(json.loads(path.read_text())) == sorted({run_key(SPEC), run_key(changed)})
+
+
+def test_a_failed_check_goes_out_and_is_never_kept(tmp_path):
+    path = tmp_path / "checks.json"
+    kept = KeptChecks(path)
+    with pytest.raises(ValueError, match="cannot be built"):
+        kept.check(SPEC, Calls(ValueError("pyod model 'KNN' cannot be built")))
+    kept.save()
+    calls = Calls()
+    KeptChecks(path).check(SPEC, calls)
+    assert calls.n == 1
+
+
+@pytest.mark.parametrize("text", ["{not json", '{"a": 1}', "[1, 2]", ""])
+def test_an_unreadable_file_is_checked_anew_and_written_again(tmp_path, text):
+    path = tmp_path / "checks.json"
+    path.write_text(text)
+    kept, calls = KeptChecks(path), Calls()
+    kept.check(SPEC, calls)
+    kept.save()
+    assert calls.n == 1 and json.loads(path.read_text()) == [run_key(SPEC)]
+
+
+def test_other_code_or_library_versions_check_again(tmp_path, monkeypatch):
+    path = tmp_path / "checks.json"
+    kept = KeptChecks(path)
+    kept.check(SPEC, Calls())
+    kept.save()
+    monkeypatch.setattr(param_checks, "_code_and_versions", lambda: "other code")
+    calls = Calls()
+    KeptChecks(path).check(SPEC, calls)
+    assert calls.n == 1
+
+
+def test_the_key_reads_every_detector_source_file(tmp_path, monkeypatch):
+    """A module of the detectors that the registry does not import changes the key too."""
+    import alfa_bench.methods
+
+    before = param_checks._code_and_versions()
+    extra = tmp_path / "methods"
+    extra.mkdir()
+    (extra / "new_method.py").write_text("X = 1\n")
+    monkeypatch.setattr(alfa_bench.methods, "__path__", [*alfa_bench.methods.__path__,
+                                                         str(extra)])
+    param_checks._code_and_versions.cache_clear()
+    try:
+        assert param_checks._code_and_versions() != before
+    finally:
+        monkeypatch.undo()
+        param_checks._code_and_versions.cache_clear()
+    assert param_checks._code_and_versions() == before
+
+
+def test_a_plugins_run_is_checked_every_time(tmp_path):
+    """Its source is not alfa-bench's, so no key names it; nor a nested run over it."""
+    path = tmp_path / "checks.json"
+    for spec in ({"detector": "cusum", "params": {"h": 5.0}},
+                 {"detector": "nested_selection", "params": {"detector": "cusum"}}):
+        calls = Calls()
+        for _ in range(2):
+            kept = KeptChecks(path)
+            kept.check(spec, calls)
+            kept.save()
+        assert calls.n == 2 and run_key(spec) is None

@@ -1,0 +1,114 @@
+"""The config's checks of each run's parameters, kept between runs of the workflow.
+
+The process that plans a run checks every config run before any job
+(:meth:`~alfa_bench.methods.base.Detector.check_params`); a PyOD or river run's check
+builds its model, which imports the library and scikit-learn: 1.4 s of each
+``snakemake`` start. A check that passed is kept in the working directory's
+``.snakemake`` folder (:data:`KEPT`), keyed by the run's detector and parameters, the
+source of the detectors and the data layer (every file of ``alfa_bench.methods`` and
+``alfa_bench.data``) and the versions of Python and the libraries a check may import:
+the same key gives the same check, so it is not made again. A failed check is never
+kept, nor one of an installed plugin's detector, and a file that cannot be read is
+checked anew and written again.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import platform
+import tempfile
+from collections.abc import Callable
+from functools import cache
+from importlib import metadata
+from pathlib import Path
+
+__all__ = ["KEPT", "KeptChecks", "run_key"]
+
+#: where the passed checks are kept, in the working directory
+KEPT = Path(".snakemake/alfa-bench/param-checks.json")
+#: the libraries a check may import (a model built by name)
+_LIBRARIES = ("numpy", "scipy", "scikit-learn", "pyod", "river")
+
+
+@cache
+def _code_and_versions() -> str:
+    import alfa_bench.data
+    import alfa_bench.methods
+
+    h = hashlib.sha256()
+    for package in (alfa_bench.methods, alfa_bench.data):
+        for folder in package.__path__:
+            for path in sorted(Path(folder).rglob("*.py")):
+                h.update(f"{package.__name__}/{path.relative_to(folder)}\0".encode())
+                h.update(path.read_bytes())
+    versions = {"python": platform.python_version()}
+    for name in _LIBRARIES:
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            versions[name] = None
+    h.update(json.dumps(versions, sort_keys=True).encode())
+    return h.hexdigest()
+
+
+def run_key(spec: dict) -> str | None:
+    """The key of a config run's check: its detector and parameters, the code and the
+    versions (module docstring); None for a run of an installed plugin's detector (or
+    a nested selection over one), whose source is not alfa-bench's: its check is made
+    every time."""
+    from alfa_bench.methods import BUILTIN_ENTRIES
+
+    named = [spec["detector"], (spec.get("params") or {}).get("detector")]
+    if any(n not in BUILTIN_ENTRIES for n in named if n is not None):
+        return None
+    document = {"detector": spec["detector"], "params": spec.get("params"),
+                "code": _code_and_versions()}
+    return hashlib.sha256(json.dumps(document, sort_keys=True, default=repr)
+                          .encode()).hexdigest()
+
+
+class KeptChecks:
+    """The passed checks of the working directory (:data:`KEPT`): :meth:`check` each
+    config run, then :meth:`save`.
+
+    Parameters
+    ----------
+    path : path
+        The file they are kept in.
+    """
+
+    def __init__(self, path: str | os.PathLike = KEPT):
+        self.path = Path(path)
+        try:
+            keys = json.loads(self.path.read_text())
+        except (OSError, ValueError):      # none yet, or unreadable: checked anew
+            keys = []
+        self.kept_ = ({k for k in keys if isinstance(k, str)} if isinstance(keys, list)
+                      else set())
+        self.passed_: set[str] = set()
+        self.made_ = 0
+
+    def check(self, spec: dict, check: Callable[[], None]) -> None:
+        """Call ``check`` (the run's :meth:`check_params`) unless the run's check is
+        kept; an exception it raises goes out, and the run is not kept."""
+        key = run_key(spec)
+        if key is None or key not in self.kept_:
+            check()
+            self.made_ += 1
+        if key is not None:
+            self.passed_.add(key)
+
+    def save(self) -> None:
+        """Keep the checks passed, and only those: the file holds the config's runs'."""
+        if self.passed_ == self.kept_:
+            return
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        # written whole, then renamed: two runs planned at once never read half a file
+        fd, tmp = tempfile.mkstemp(dir=self.path.parent, prefix=self.path.name,
+                                   suffix=".tmp")
+        with os.fdopen(fd, "w") as f:
+            json.dump(sorted(self.passed_), f)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, self.path)
