@@ -182,11 +182,13 @@ PARTS_JOB = (f"{shlex.quote(sys.executable)} -m alfa_bench.workflow.parts_job "
 
 # On one machine the detect jobs fork from a server that has loaded the imports and the
 # flights once, and the parts jobs from another (workflow/forkserver.py); a cluster's
-# jobs run each in its own process.
+# jobs run each in its own process. One detect job alone (one run changed) runs in its
+# own process too: the server loads every run's imports, and it ended about a second
+# later than the job on its own (BENCHMARKS.md)
 onstart:
     if workflow.local_exec:
-        needed = {j.rule.name for j in workflow.dag.needrun_jobs()}
-        if any(name.startswith("detect") for name in needed):
+        needed = [j.rule.name for j in workflow.dag.needrun_jobs()]
+        if sum(name in ("detect", "detect_reference") for name in needed) > 1:
             forkserver.start(SERVER_ENV, "alfa_bench.workflow.detect_job:server_jobs",
                              [JOB_CONFIG], "results/logs/detect_server.log")
         if any(name.startswith("run_parts") for name in needed):
