@@ -61,7 +61,7 @@ INJECTED_PROCESSED = "results/injected/processed"
 # the schema checks the config's shape; each method's detector and parameter names are
 # checked against the registry here, before any job runs, by the process that plans the
 # run: a cluster job's process, which parses the workflow again, imports no detector
-_checks = KeptChecks()
+_checks = KeptChecks() if workflow.is_main_process else None
 for _name, _spec in config["methods"].items() if workflow.is_main_process else ():
     try:
         _detector = make_detector(_spec["detector"], _spec.get("params"))

@@ -1,6 +1,9 @@
 """The config's checks of each run's parameters, kept between runs (workflow/param_checks.py)."""
 
 import json
+import logging
+import os
+import sys
 
 import pytest
 
@@ -49,14 +52,44 @@ def test_a_failed_check_goes_out_and_is_never_kept(tmp_path):
     assert calls.n == 1
 
 
-@pytest.mark.parametrize("text", ["{not json", '{"a": 1}', "[1, 2]", ""])
+@pytest.mark.parametrize("text", ["{not json", '{"a": 1}', "[1, 2]", "", "[" * 100_000,
+                                  b"\xff\xfe"])
 def test_an_unreadable_file_is_checked_anew_and_written_again(tmp_path, text):
     path = tmp_path / "checks.json"
-    path.write_text(text)
+    path.write_bytes(text if isinstance(text, bytes) else text.encode())
     kept, calls = KeptChecks(path), Calls()
     kept.check(SPEC, calls)
     kept.save()
     assert calls.n == 1 and json.loads(path.read_text()) == [run_key(SPEC)]
+
+
+@pytest.mark.parametrize("kind", ["folder", "pipe"])
+def test_a_folder_or_pipe_in_its_place_is_not_read_and_the_run_goes_on(tmp_path, kind,
+                                                                        caplog):
+    path = tmp_path / "checks.json"
+    path.mkdir() if kind == "folder" else os.mkfifo(path)
+    kept, calls = KeptChecks(path), Calls()
+    kept.check(SPEC, calls)
+    with caplog.at_level(logging.WARNING):
+        kept.save()
+    assert calls.n == 1
+    assert [p.name for p in tmp_path.iterdir()] == ["checks.json"]   # no temporary left
+    if kind == "folder":    # not replaced: named, and the run goes on
+        assert "could not be kept in" in caplog.text
+    else:                   # replaced by the file
+        assert json.loads(path.read_text()) == [run_key(SPEC)]
+
+
+def test_parameters_json_cannot_order_are_checked_every_time(tmp_path):
+    spec = {"detector": "pyod", "params": {"model": "KNN",
+                                           "params": {"metric_params": {1: 2, "p": 3}}}}
+    assert run_key(spec) is None
+    calls = Calls()
+    for _ in range(2):
+        kept = KeptChecks(tmp_path / "checks.json")
+        kept.check(spec, calls)
+        kept.save()
+    assert calls.n == 2
 
 
 def test_other_code_or_library_versions_check_again(tmp_path, monkeypatch):
@@ -68,6 +101,20 @@ def test_other_code_or_library_versions_check_again(tmp_path, monkeypatch):
     calls = Calls()
     KeptChecks(path).check(SPEC, calls)
     assert calls.n == 1
+
+
+def test_a_library_installed_or_removed_checks_again(tmp_path, monkeypatch):
+    """A model may need a library alfa-bench does not install (xgboost, torch)."""
+    before = param_checks._code_and_versions()
+    (tmp_path / "xgboost-3.0.0.dist-info").mkdir()
+    monkeypatch.setattr(sys, "path", [*sys.path, str(tmp_path)])
+    param_checks._code_and_versions.cache_clear()
+    try:
+        assert param_checks._code_and_versions() != before
+    finally:
+        monkeypatch.undo()
+        param_checks._code_and_versions.cache_clear()
+    assert param_checks._code_and_versions() == before
 
 
 def test_the_key_reads_every_detector_source_file(tmp_path, monkeypatch):
