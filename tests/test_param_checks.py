@@ -103,11 +103,11 @@ def test_other_code_or_library_versions_check_again(tmp_path, monkeypatch):
     assert calls.n == 1
 
 
-def test_a_library_installed_or_removed_checks_again(tmp_path, monkeypatch):
-    """A model may need a library alfa-bench does not install (xgboost, torch)."""
+def _key_moves_and_comes_back(monkeypatch, owner, name, value) -> None:
+    """The code and versions part of the key differs with ``owner.name`` set to
+    ``value``, and is what it was once it is undone."""
     before = param_checks._code_and_versions()
-    (tmp_path / "xgboost-3.0.0.dist-info").mkdir()
-    monkeypatch.setattr(sys, "path", [*sys.path, str(tmp_path)])
+    monkeypatch.setattr(owner, name, value)
     param_checks._code_and_versions.cache_clear()
     try:
         assert param_checks._code_and_versions() != before
@@ -115,25 +115,23 @@ def test_a_library_installed_or_removed_checks_again(tmp_path, monkeypatch):
         monkeypatch.undo()
         param_checks._code_and_versions.cache_clear()
     assert param_checks._code_and_versions() == before
+
+
+def test_a_library_installed_or_removed_checks_again(tmp_path, monkeypatch):
+    """A model may need a library alfa-bench does not install (xgboost, torch)."""
+    (tmp_path / "xgboost-3.0.0.dist-info").mkdir()
+    _key_moves_and_comes_back(monkeypatch, sys, "path", [*sys.path, str(tmp_path)])
 
 
 def test_the_key_reads_every_detector_source_file(tmp_path, monkeypatch):
     """A module of the detectors that the registry does not import changes the key too."""
     import alfa_bench.methods
 
-    before = param_checks._code_and_versions()
     extra = tmp_path / "methods"
     extra.mkdir()
     (extra / "new_method.py").write_text("X = 1\n")
-    monkeypatch.setattr(alfa_bench.methods, "__path__", [*alfa_bench.methods.__path__,
-                                                         str(extra)])
-    param_checks._code_and_versions.cache_clear()
-    try:
-        assert param_checks._code_and_versions() != before
-    finally:
-        monkeypatch.undo()
-        param_checks._code_and_versions.cache_clear()
-    assert param_checks._code_and_versions() == before
+    _key_moves_and_comes_back(monkeypatch, alfa_bench.methods, "__path__",
+                              [*alfa_bench.methods.__path__, str(extra)])
 
 
 def test_a_plugins_run_is_checked_every_time(tmp_path):
