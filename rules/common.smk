@@ -58,33 +58,39 @@ SUBSETS = [PRIMARY, *(s for s in config["subsets"] if s != PRIMARY)]
 # where `snakemake injected_csv` writes the injected flights, and so their folder name
 INJECTED_PROCESSED = "results/injected/processed"
 
-# the schema checks the config's shape; each method's detector and parameter names are
-# checked against the registry here, before any job runs, by the process that plans the
-# run: a cluster job's process, which parses the workflow again, imports no detector
-_checks = KeptChecks() if workflow.is_main_process else None
-for _name, _spec in config["methods"].items() if workflow.is_main_process else ():
-    try:
-        _detector = make_detector(_spec["detector"], _spec.get("params"))
-        # a library's model by name, imported; a check passed before is not made again
-        _checks.check(_spec, _detector.check_params)
-    except (KeyError, TypeError, ValueError) as _e:
-        raise WorkflowError(f"config methods.{_name}: {_e}") from None
-    # a misspelt signal is the config's error, not every flight's bad data
-    _unknown = [s for s in _detector.signals() if s not in SIGNALS]
-    if _unknown:
-        raise WorkflowError(f"config methods.{_name}: unknown signal(s) {_unknown}; known: "
-                            f"{sorted(SIGNALS)}")
-    if not _detector.causal and _spec.get("role", "method") != "reference":
-        raise WorkflowError(f"config methods.{_name}: detector {_spec['detector']!r} is not "
-                            "causal, so it can only be a reference row (role: reference)")
-    # the run's own grouping, else the config's: either way it is the run's
-    _grouping = own_calibration(config["calibration"], _spec)["group_by"]
-    if _grouping != "date" and _spec.get("role", "method") != "reference":
-        raise WorkflowError(f"config methods.{_name}: calibration.group_by: {_grouping} lets "
-                            "flights of the scored date train it, so it can only be a "
-                            "reference row (role: reference)")
+def _check_config_runs():
+    """The schema checks the config's shape; each method's detector and parameter names
+    are checked against the registry here, before any job runs (a check passed before
+    is kept: workflow/param_checks.py)."""
+    checks = KeptChecks()
+    for name, spec in config["methods"].items():
+        try:
+            detector = make_detector(spec["detector"], spec.get("params"))
+            # a library's model by name, imported
+            checks.check(spec, detector.check_params)
+        except (KeyError, TypeError, ValueError) as e:
+            raise WorkflowError(f"config methods.{name}: {e}") from None
+        # a misspelt signal is the config's error, not every flight's bad data
+        unknown = [s for s in detector.signals() if s not in SIGNALS]
+        if unknown:
+            raise WorkflowError(f"config methods.{name}: unknown signal(s) {unknown}; known: "
+                                f"{sorted(SIGNALS)}")
+        if not detector.causal and spec.get("role", "method") != "reference":
+            raise WorkflowError(f"config methods.{name}: detector {spec['detector']!r} is not "
+                                "causal, so it can only be a reference row (role: reference)")
+        # the run's own grouping, else the config's: either way it is the run's
+        grouping = own_calibration(config["calibration"], spec)["group_by"]
+        if grouping != "date" and spec.get("role", "method") != "reference":
+            raise WorkflowError(f"config methods.{name}: calibration.group_by: {grouping} lets "
+                                "flights of the scored date train it, so it can only be a "
+                                "reference row (role: reference)")
+    checks.save()
+
+
+# by the process that plans the run: a cluster job's process, which parses the workflow
+# again, imports no detector
 if workflow.is_main_process:
-    _checks.save()
+    _check_config_runs()
 
 
 # what a run taken out of the config left: named once, removed on request
