@@ -1,4 +1,5 @@
 import hashlib
+import socket
 import sys
 import tempfile
 from pathlib import Path
@@ -11,7 +12,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from loopback import make_archive, serve_archive  # noqa: E402
 from slurm_cluster import slurm_profile, slurm_unavailable, through_slurm  # noqa: E402
 from unavailable import unavailable  # noqa: E402
-from workflow_runs import GRID, REPO, run_workflow  # noqa: E402
+from workflow_runs import GRID, REPO, made_once, run_workflow  # noqa: E402
 
 from alfa_bench.data import build_manifest, load_flight, resolve_alfa_dir  # noqa: E402
 from alfa_bench.data.synthetic import write_corpus, write_flight  # noqa: E402
@@ -24,6 +25,31 @@ def pytest_report_header(config):
         return f"ALFA_DIR={REAL_ALFA}: tests on the real flights will run"
     return ("*** ALFA_DIR is not set or has no processed/: the tests on the real ALFA "
             "flights are SKIPPED ***")
+
+
+#: the port the corpus's archive is served on, reserved by the session's first process
+ARCHIVE_PORT = pytest.StashKey[socket.socket]()
+
+
+def pytest_configure(config):
+    # every worker serves the same archive on one port (SO_REUSEPORT), so that every
+    # workflow run of the session has the same config and results compare byte for
+    # byte across workers; a bound socket that does not listen keeps the port
+    if not hasattr(config, "workerinput"):
+        reserved = socket.socket()
+        reserved.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
+        reserved.bind(("127.0.0.1", 0))
+        config.stash[ARCHIVE_PORT] = reserved
+
+
+def pytest_unconfigure(config):
+    if ARCHIVE_PORT in config.stash:
+        config.stash[ARCHIVE_PORT].close()
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_configure_node(node):
+    node.workerinput["archive_port"] = node.config.stash[ARCHIVE_PORT].getsockname()[1]
 
 
 @pytest.hookimpl(tryfirst=True, optionalhook=True)
@@ -41,6 +67,9 @@ def pytest_collection_modifyitems(items):
     for item in items:
         if "[config:" in item.nodeid:
             item.add_marker(pytest.mark.slow)
+    # the SLURM run's tests last: their worker makes the reference runs first, which the
+    # other worker's tests of a damaged corpus compare with (tests/scheduling.py)
+    items.sort(key=lambda item: "slurm_run" in getattr(item, "fixturenames", ()))
 
 
 @pytest.fixture(scope="session")
@@ -79,16 +108,19 @@ def one_flight(tmp_path) -> Path:
 
 
 @pytest.fixture(scope="session")
-def overlay(corpus, tmp_path_factory):
+def overlay(corpus, tmp_path_factory, pytestconfig):
     """The workflow runs' own config: the small grid, and the corpus served as ALFA's
-    archive from a loopback stand-in for KiltHub (its port fixed, so runs share a config)."""
+    archive from a loopback stand-in for KiltHub, on the session's port (every worker's
+    the same: runs share a config)."""
     archive = make_archive(corpus)
-    with serve_archive(archive) as (api, requests):
+    port = (pytestconfig.workerinput["archive_port"] if hasattr(pytestconfig, "workerinput")
+            else pytestconfig.stash[ARCHIVE_PORT].getsockname()[1])
+    with serve_archive(archive, port=port) as (api, _):
         path = tmp_path_factory.mktemp("overlay") / "overlay.yaml"
         path.write_text(yaml.safe_dump({"injection": GRID, "download": {
             "api": api, "file": "processed.zip", "md5": hashlib.md5(archive).hexdigest(),
             "sha256": None, "dest": "resources/alfa"}}))
-        yield path, requests
+        yield path
 
 
 #: what the SLURM run makes: a detect job of each kind (numba's kernels, a nested
@@ -111,21 +143,25 @@ def slurm_run(overlay, tmp_path_factory):
     root = tmp_path_factory.mktemp("slurm")
     work = root / "run"
     profile = slurm_profile(REPO / "profiles/slurm", root / "profile")
-    config, _ = overlay
     return through_slurm(root / "cluster", work, "rule_detect_wildcards_", lambda env: run_workflow(
-        work, None, "--configfile", str(REPO / "config/config.yaml"), str(config),
+        work, None, "--configfile", str(REPO / "config/config.yaml"), str(overlay),
         "--profile", str(profile), target=SLURM_TARGETS, ok=None, quiet=False, env=env))
 
 
 @pytest.fixture(scope="session")
-def runs(overlay):
+def runs(overlay, tmp_path_factory):
     """Two runs of the README's first command, each downloading the archive: the
     reference that the workflow tests read and that other ways of running it match,
-    and a second that must give its results byte for byte."""
-    config, requests = overlay
-    dirs = [Path(tempfile.mkdtemp(prefix=f"run{i}", dir=config.parent)) for i in range(2)]
-    for d in dirs:
-        before = requests.count("/file/1")
-        run_workflow(d, None, "--configfile", str(REPO / "config/config.yaml"), str(config))
-        assert requests.count("/file/1") == before + 1
-    return dirs
+    and a second that must give its results byte for byte. Made once per session, by
+    the first worker that asks (workflow_runs.made_once)."""
+    def make():
+        dirs = [Path(tempfile.mkdtemp(prefix=f"run{i}", dir=overlay.parent))
+                for i in range(2)]
+        for d in dirs:
+            run_workflow(d, None, "--configfile", str(REPO / "config/config.yaml"),
+                         str(overlay))
+            log = (d / "results/logs/download_alfa.log").read_text()
+            assert "downloading processed.zip" in log and "verified processed.zip" in log
+        return [str(d) for d in dirs]
+
+    return [Path(d) for d in made_once(tmp_path_factory, "runs", make)]

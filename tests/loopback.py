@@ -16,24 +16,31 @@ from pathlib import Path
 
 
 def make_archive(processed: Path, prefix: str = "processed/", extras: bool = True) -> bytes:
-    """A zip of the flights under ``processed`` as ``prefix<flight>/<file>``."""
+    """A zip of the flights under ``processed`` as ``prefix<flight>/<file>``: the same
+    bytes for the same flights, whenever they were written (its MD5 is in the config)."""
     buf = io.BytesIO()
+
+    def add(name: str, data: bytes) -> None:
+        z.writestr(zipfile.ZipInfo(name, date_time=(2018, 7, 18, 0, 0, 0)), data)
+
     with zipfile.ZipFile(buf, "w") as z:
         for flight in sorted(p for p in processed.iterdir() if p.is_dir()):
             for f in sorted(flight.glob("*.csv")):
-                z.write(f, f"{prefix}{flight.name}/{f.name}")
+                add(f"{prefix}{flight.name}/{f.name}", f.read_bytes())
             if extras:
-                z.writestr(f"{prefix}{flight.name}/{flight.name}.bag", b"#ROSBAG V2.0\n" * 64)
-                z.writestr(f"{prefix}{flight.name}/{flight.name}.mat", b"MATLAB 5.0" * 64)
+                add(f"{prefix}{flight.name}/{flight.name}.bag", b"#ROSBAG V2.0\n" * 64)
+                add(f"{prefix}{flight.name}/{flight.name}.mat", b"MATLAB 5.0" * 64)
     return buf.getvalue()
 
 
 @contextlib.contextmanager
 def serve_archive(archive: bytes, *, name: str = "processed.zip", md5: str | None = None,
-                  truncate: bool = False):
+                  truncate: bool = False, port: int = 0):
     """Serve ``archive`` on 127.0.0.1; yield ``(api_url, requests)``, where
     ``requests`` lists the paths asked for. ``md5`` overrides the listed MD5;
-    ``truncate`` breaks the connection half-way through the file."""
+    ``truncate`` breaks the connection half-way through the file. A ``port`` given is
+    shared (SO_REUSEPORT) with the processes serving the same archive on it, as the
+    test workers do: the kernel hands each connection to one of them."""
     requests: list[str] = []
     state: dict = {}
 
@@ -53,7 +60,10 @@ def serve_archive(archive: bytes, *, name: str = "processed.zip", md5: str | Non
         def log_message(self, *args):
             pass
 
-    httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Handler)
+    class Server(http.server.ThreadingHTTPServer):
+        allow_reuse_port = bool(port)
+
+    httpd = Server(("127.0.0.1", port), Handler)
     base = f"http://127.0.0.1:{httpd.server_address[1]}"
     state["files"] = {"/file/1": archive}
     state["api"] = json.dumps([{

@@ -1,15 +1,17 @@
 """How pytest-xdist shares the suite between its workers (`-n 2`, pyproject.toml).
 
-The session's workflow runs (conftest.py's ``runs``, ``overlay``, ``slurm_run``) cost
-minutes each, and a worker that needs one makes its own: every test that takes one of
-them, with the tests sharing a fixture of its file, goes to one worker in one unit, so
-they are made once and first; the rest go file by file (a module's fixtures stay on
-one worker) to whichever worker is free. Two tests there also change a module of the
-repo for a moment (workflow_runs.dry_run_with_changed) and compare against ``runs``:
-one worker keeps them in order. xdist's own ``loadgroup`` would group by mark, but
-xdist 3.8 renames the items for it through an attribute pytest 9 no longer reads; the
-controller sees test ids only, so the tests are found here, in each file's source, by
-the parameters of its functions.
+The session's workflow runs cost minutes each. Two units go first, one to each worker:
+the tests of conftest.py's runs (``runs``, the reference; ``slurm_run``, which compares
+with it; ``overlay``), and the tests of the files' own runs (a file's fixture that takes
+``overlay`` makes a run of its own), each unit with the tests sharing a fixture of its
+file with them; so both workers make runs from the start, each run once. A test of the
+second unit that compares with ``runs`` reads the reference runs of the first worker
+(conftest.py makes them once per session, whichever worker asks first, and the other
+waits for them; it orders the SLURM run's tests last, so they are made first). The rest
+go file by file (a module's fixtures stay on one worker) to whichever worker is free.
+xdist's own ``loadgroup`` would group by mark, but xdist 3.8 renames the items for it
+through an attribute pytest 9 no longer reads; the controller sees test ids only, so the
+tests are found here, in each file's source, by the parameters of its functions.
 """
 
 import ast
@@ -18,23 +20,22 @@ from pathlib import Path
 
 from xdist.scheduler import LoadScopeScheduling
 
-#: the session fixtures one worker makes
+#: conftest.py's workflow runs, and the config every run of the session shares
 SHARED = frozenset({"runs", "overlay", "slurm_run"})
-#: the work unit of the tests that take one
-GROUP = "the session's workflow runs"
+#: the two work units
+GROUPS = ("conftest.py's workflow runs", "the files' own workflow runs")
 
 
 @cache
-def grouped(path: Path) -> frozenset[str]:
-    """The test functions of a file that go to the group: those taking a shared
-    fixture, directly or through the file's own fixtures, and those sharing one of the
-    file's fixtures with them."""
+def grouped(path: Path) -> dict[str, str]:
+    """The test functions of a file that go to a unit of :data:`GROUPS`, with their
+    unit: the tests joined by the file's own fixtures (a union-find) go together; to the
+    second unit when one of those fixtures makes its own run (it takes ``overlay``), else
+    to the first when one of them takes a fixture of :data:`SHARED`."""
     tree = ast.parse(path.read_text(), str(path))
     params = {node.name: {a.arg for a in node.args.args + node.args.kwonlyargs}
               for node in ast.walk(tree)
               if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef)}
-    # a union-find over the file's functions and the shared fixtures: a function is one
-    # with each of its parameters that is a fixture of the file or a shared one
     parent: dict[str, str] = {}
 
     def root(name: str) -> str:
@@ -43,16 +44,18 @@ def grouped(path: Path) -> frozenset[str]:
         return name
 
     for name, args in params.items():
-        for arg in args & (set(params) | SHARED):
+        for arg in args & set(params):
             parent[root(arg)] = root(name)
-    shared = {root(name) for name in SHARED}
-    return frozenset(name for name in params
-                     if name.startswith("test") and root(name) in shared)
+    own = {root(n) for n, args in params.items()
+           if "overlay" in args and not n.startswith("test")}
+    shared = {root(n) for n, args in params.items() if args & SHARED} - own
+    return {n: GROUPS[1] if root(n) in own else GROUPS[0] for n in params
+            if n.startswith("test") and root(n) in own | shared}
 
 
 class SharedRunsScheduling(LoadScopeScheduling):
-    """Load by file, but the tests of :func:`grouped` in one unit, handed out first
-    (module docstring); then the files with the most tests first."""
+    """Load by file, but the tests of :func:`grouped` in their two units, handed out
+    first (module docstring); then the files with the most tests first."""
 
     def __init__(self, config, log=None):
         super().__init__(config, log)
@@ -62,9 +65,10 @@ class SharedRunsScheduling(LoadScopeScheduling):
         file, _, rest = nodeid.partition("::")
         path = self.rootpath / file
         test = rest.rsplit("::", 1)[-1].split("[", 1)[0]
-        return GROUP if path.suffix == ".py" and test in grouped(path) else file
+        return grouped(path).get(test, file) if path.suffix == ".py" else file
 
     def _assign_work_unit(self, node) -> None:
-        if GROUP in self.workqueue:
-            self.workqueue.move_to_end(GROUP, last=False)
+        for group in reversed(GROUPS):
+            if group in self.workqueue:
+                self.workqueue.move_to_end(group, last=False)
         super()._assign_work_unit(node)

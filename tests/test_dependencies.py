@@ -77,7 +77,7 @@ def test_a_changed_module_reruns_the_jobs_that_import_it_and_those_after(runs, o
                                                                          module):
     """A dry run over the reference run, with ``module``'s text changed by one comment
     line (Snakemake compares small inputs by content) and restored byte for byte."""
-    done = dry_run_with_changed(REPO / module, runs[1], overlay[0], "test_dependencies")
+    done = dry_run_with_changed(REPO / module, runs[1], overlay, "test_dependencies")
     assert done.returncode == 0, done.stdout + done.stderr
     planned = set(re.findall(r"^(?:local)?rule (\w+):$", done.stdout, re.MULTILINE))
     assert planned == AFTER_A_CHANGE[module], done.stdout

@@ -87,7 +87,7 @@ def test_a_config_run_of_the_plugin_lands_in_the_comparison(installed, runs, ove
     done = subprocess.run([sys.executable, "-m", "snakemake", "results/tables/comparison.md",
                            "--cores", "2", "--quiet", "--snakefile", str(REPO / "Snakefile"),
                            "--directory", str(work), "--configfile",
-                           str(REPO / "config/config.yaml"), str(overlay[0]), str(extra)],
+                           str(REPO / "config/config.yaml"), str(overlay), str(extra)],
                           capture_output=True, text=True, env=env)
     assert done.returncode == 0, done.stdout + done.stderr
     table = (work / "results/tables/comparison.md").read_text()

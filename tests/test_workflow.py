@@ -327,7 +327,7 @@ def test_a_changed_method_module_reruns_exactly_its_jobs(runs, overlay):
     (methods/windows.py, methods/extremes.py) but not its module. (Snakemake compares small
     inputs by content, so the module's text changes, by one comment line, and is
     restored byte for byte.)"""
-    done = dry_run_with_changed(REPO / "methods/residual_bank.py", runs[1], overlay[0],
+    done = dry_run_with_changed(REPO / "methods/residual_bank.py", runs[1], overlay,
                                 "test_workflow")
     jobs = re.findall(r"rule (\w+):\n(?:    .*\n)*?    wildcards: method=(\w+)", done.stdout)
     using = ("bench_logistic", "bench_logistic_no_emr", "learned_fusion", "residual_bank",
@@ -719,7 +719,7 @@ def damaged(corpus, overlay, tmp_path_factory):
     work = root / "run"
     work.mkdir()
     done = run_workflow(work, processed.parent, "--keep-going", "--configfile",
-                        str(REPO / "config/config.yaml"), str(overlay[0]))
+                        str(REPO / "config/config.yaml"), str(overlay))
     refused = {onset_out.name, spike.name, "not_an_alfa_name", nan_cell.name, late.name,
                "carbonZ_2018-09-11-14-41-51_elevator_failure", back.name, word.name,
                empty.name, gone.name, unreadable.name, gap.name}
@@ -890,3 +890,4 @@ def test_a_parts_job_forked_from_its_server_writes_what_it_writes_alone(runs, tm
         p.name for p in (tmp_path / "rerun").glob("*.rrd"))
     for p in recordings:
         assert content(p) == content(tmp_path / "rerun" / p.name), p.name
+

@@ -1,14 +1,46 @@
 """Running the workflow in a subprocess, and comparing two runs' results."""
 
+import contextlib
+import fcntl
+import hashlib
+import json
 import os
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 from recordings import content
 
 REPO = Path(__file__).resolve().parent.parent
 SNAKEMAKE = [sys.executable, "-m", "snakemake"]
+#: held shared by every workflow run of the tests, and exclusively by
+#: :func:`dry_run_with_changed` while it changes a module of the repo: a run on another
+#: worker would otherwise record the change (a dirty tree in its provenance). Named for
+#: the checkout, so that every test process on it shares it
+SOURCES_LOCK = Path(tempfile.gettempdir()) / (
+    f"alfa-bench-sources-{hashlib.sha256(str(REPO).encode()).hexdigest()[:12]}.lock")
+
+
+@contextlib.contextmanager
+def _sources(mode: int):
+    with open(SOURCES_LOCK, "a") as lock:
+        fcntl.flock(lock, mode)
+        yield
+
+
+def made_once(tmp_path_factory, name: str, make):
+    """``make()``'s value (JSON), made by the first of the session's processes (the
+    xdist workers) that asks; the others wait for it, then read it. A ``make`` that
+    fails is tried again by the next to ask."""
+    base = tmp_path_factory.getbasetemp()
+    root = base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+    done = root / f"{name}.json"
+    with open(root / f"{name}.lock", "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not done.exists():
+            done.write_text(json.dumps(make()))
+        return json.loads(done.read_text())
 
 #: a small injected grid for the tests (config/config.yaml's is for the real flights)
 GRID = {"sensors": ["roll", "airspeed", "pitch_rate"],
@@ -31,7 +63,8 @@ def run_workflow(workdir: Path, alfa_dir: Path | None, *args: str,
     cmd = [*SNAKEMAKE, *targets, "--cores", "2", "--snakefile", str(REPO / "Snakefile"),
            "--directory", str(workdir), "--configfile", str(REPO / "config/config.yaml"),
            *(["--quiet"] if quiet else []), *args]
-    done = subprocess.run(cmd, env=env, capture_output=True, text=True)
+    with _sources(fcntl.LOCK_SH):
+        done = subprocess.run(cmd, env=env, capture_output=True, text=True)
     assert ok is None or (done.returncode == 0) == ok, done.stdout + done.stderr
     return done
 
@@ -42,16 +75,17 @@ def dry_run_with_changed(module: Path, workdir: Path, overlay: Path, tag: str
     one comment line (Snakemake compares small inputs by content), restored byte for
     byte, its times too, whatever the run did."""
     text, stat = module.read_bytes(), module.stat()
-    try:
-        module.write_bytes(text + f"# changed by {tag}\n".encode())
-        env = {k: v for k, v in os.environ.items() if k != "ALFA_DIR"}
-        return subprocess.run([*SNAKEMAKE, "all", "-n", "--cores", "2", "--snakefile",
-                               str(REPO / "Snakefile"), "--directory", str(workdir),
-                               "--configfile", str(REPO / "config/config.yaml"),
-                               str(overlay)], env=env, capture_output=True, text=True)
-    finally:
-        module.write_bytes(text)
-        os.utime(module, ns=(stat.st_atime_ns, stat.st_mtime_ns))
+    with _sources(fcntl.LOCK_EX):
+        try:
+            module.write_bytes(text + f"# changed by {tag}\n".encode())
+            env = {k: v for k, v in os.environ.items() if k != "ALFA_DIR"}
+            return subprocess.run([*SNAKEMAKE, "all", "-n", "--cores", "2", "--snakefile",
+                                   str(REPO / "Snakefile"), "--directory", str(workdir),
+                                   "--configfile", str(REPO / "config/config.yaml"),
+                                   str(overlay)], env=env, capture_output=True, text=True)
+        finally:
+            module.write_bytes(text)
+            os.utime(module, ns=(stat.st_atime_ns, stat.st_mtime_ns))
 
 
 def assert_same_results(a: Path, b: Path, part: bool = False) -> int:
