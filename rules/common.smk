@@ -16,6 +16,7 @@ from alfa_bench.workflow.dependencies import module_sources, script_sources
 from alfa_bench.workflow.detect_job import SERVER_ENV, write_job_config
 from alfa_bench.workflow.param_checks import KeptChecks
 from alfa_bench.workflow.parts_job import SERVER_ENV as PARTS_SERVER_ENV
+from alfa_bench.workflow.script_job import SERVER_ENV as SCRIPT_SERVER_ENV
 from alfa_bench.workflow.logs import closing_lines
 from alfa_bench.workflow.stale import remove, stale_results
 from alfa_bench.workflow.resources import count_flights, job_resources
@@ -187,16 +188,21 @@ PARTS_JOB = (f"{shlex.quote(sys.executable)} -m alfa_bench.workflow.parts_job "
 
 
 # On one machine the detect jobs fork from a server that has loaded the imports and the
-# flights once, and the parts jobs from another (workflow/forkserver.py); a cluster's
-# jobs run each in its own process. One detect job alone (one run changed) runs in its
-# own process too: the server loads every run's imports, and it ended about a second
-# later than the job on its own (BENCHMARKS.md)
+# flights once, the parts jobs from another, the scripts from a third
+# (workflow/forkserver.py); a cluster's jobs run each in its own process. One detect job
+# alone (one run changed) runs in its own process too: the server loads every run's
+# imports, and it ended about a second later than the job on its own (BENCHMARKS.md);
+# so does one script job alone
 onstart:
     if workflow.local_exec:
-        needed = [j.rule.name for j in workflow.dag.needrun_jobs()]
-        if sum(name in ("detect", "detect_reference") for name in needed) > 1:
+        needed = [j.rule for j in workflow.dag.needrun_jobs()]
+        if sum(r.name in ("detect", "detect_reference") for r in needed) > 1:
             forkserver.start(SERVER_ENV, "alfa_bench.workflow.detect_job:server_jobs",
                              [JOB_CONFIG], "results/logs/detect_server.log")
-        if any(name.startswith("run_parts") for name in needed):
+        if any(r.name.startswith("run_parts") for r in needed):
             forkserver.start(PARTS_SERVER_ENV, "alfa_bench.workflow.parts_job:server_jobs",
                              [], "results/logs/parts_server.log")
+        if sum(r.is_script for r in needed) > 1:
+            forkserver.start(SCRIPT_SERVER_ENV, "alfa_bench.workflow.script_job:server_jobs",
+                             [Path(workflow.basedir) / "scripts"],
+                             "results/logs/script_server.log")

@@ -3,6 +3,7 @@
 onerror:
     forkserver.stop(SERVER_ENV)
     forkserver.stop(PARTS_SERVER_ENV)
+    forkserver.stop(SCRIPT_SERVER_ENV)
     if _last := failure_message(ALFA_SOURCE, ALFA_DIR):
         print(f"\n{_last}", file=sys.stderr)
 

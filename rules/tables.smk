@@ -4,6 +4,7 @@
 onsuccess:
     forkserver.stop(SERVER_ENV)
     forkserver.stop(PARTS_SERVER_ENV)
+    forkserver.stop(SCRIPT_SERVER_ENV)
     if _closing := closing_lines(PRIMARY):
         atexit.register(print, *_closing, sep="\n", file=sys.stderr, flush=True)
 

@@ -1,6 +1,11 @@
 """Snakemake script: detection rate against the deadline, as a table and a figure, and
 the detection times by fault class."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 from pathlib import Path
 
 from alfa_bench.analysis.deadline import deadline_markdown, deadline_table

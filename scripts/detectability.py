@@ -1,6 +1,11 @@
 """Snakemake script: the detectability table and curves of the injected sensor faults,
 merged from each run's part."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 from pathlib import Path
 
 from alfa_bench.analysis.detectability import detectability_markdown

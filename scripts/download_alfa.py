@@ -1,5 +1,10 @@
 """Snakemake script: download, verify and unpack the ALFA processed flights."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 import logging
 import sys
 

@@ -1,5 +1,10 @@
 """Snakemake script: the generic learners on raw windows and on physical residuals."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 from pathlib import Path
 
 from alfa_bench.analysis.features_learners import (

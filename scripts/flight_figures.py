@@ -1,6 +1,11 @@
 """Snakemake script: per flight, every method's score / threshold around the onset: the
 panels each method's detect job drew, stacked under a title and over a time axis."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 from pathlib import Path
 
 from alfa_bench.analysis.provenance import run_provenance

@@ -1,6 +1,11 @@
 """Snakemake script: the manifest of the injected sensor-fault grid, built in memory
 from the cached fault-free flights, and the flight-sensor pairs it leaves out."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 import logging
 
 import pandas as pd

@@ -1,5 +1,10 @@
 """Snakemake script: ALFA-format CSV copies of the injected sensor-fault flights."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 import logging
 from pathlib import Path
 

@@ -2,6 +2,11 @@
 sensor) and of ALFA's actuator faults (which actuator class), merged from each run's
 part."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 from pathlib import Path
 
 from alfa_bench.analysis.isolation import isolation_markdown

@@ -1,5 +1,10 @@
 """Snakemake script: the leakage audit of every catalogue signal over the flights."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 from pathlib import Path
 
 from alfa_bench.analysis.leakage import leakage_markdown, leakage_table

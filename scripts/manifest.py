@@ -3,6 +3,11 @@ results/load_failures.csv from those that cannot be read (strict: stop at the fi
 with a corpus's logs left out at conversion; write each flight read to the parsed-flight
 cache."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 import pandas as pd
 
 from alfa_bench.data import FAILURE_COLUMNS, build_manifest, scan_flights

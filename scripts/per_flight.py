@@ -2,6 +2,11 @@
 from each run's part, and the public study's reproduction against its published
 per-flight table."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 from pathlib import Path
 
 import pandas as pd

@@ -1,5 +1,10 @@
 """Snakemake script: the run's provenance, with the SHA-256 of every output."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.data import read_manifest
 from alfa_bench.outputs.provenance import write_run_file

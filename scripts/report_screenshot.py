@@ -1,6 +1,11 @@
 """Snakemake script: a screenshot of the HTML report open on the comparison, checked in a
 browser."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 import logging
 
 from alfa_bench.workflow.logs import log_to

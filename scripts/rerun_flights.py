@@ -1,6 +1,11 @@
 """Snakemake script: each flight's own part of its rerun recording (signals, fault,
 layout); each run's part is written by its run_parts job."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 import logging
 from pathlib import Path
 

@@ -1,5 +1,10 @@
 """Snakemake script: the runtime table of the detector jobs."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 from pathlib import Path
 
 from alfa_bench.analysis.provenance import run_provenance

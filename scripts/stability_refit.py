@@ -1,6 +1,11 @@
 """Snakemake script: the runs of stability.refit fitted again on the first calibration
 pools of each fold, beside the same pools' thresholds alone."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 from pathlib import Path
 
 from alfa_bench.analysis.provenance import run_provenance

@@ -1,6 +1,11 @@
 """Snakemake script: threshold sweeps of every method, merged from each run's part
 (computed from its stored traces), as a table and a figure."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 from alfa_bench.analysis.provenance import run_provenance
 from alfa_bench.analysis.sweep import merge_sweeps
 from alfa_bench.data import read_manifest

@@ -1,5 +1,10 @@
 """Snakemake script: summary, per-fault and comparison tables (CSV, Markdown, LaTeX)."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 import logging
 from pathlib import Path
 

@@ -1,6 +1,11 @@
 """Snakemake script: a screenshot of one flight's recording in rerun's web viewer, its
 parts opened together."""
 
+from alfa_bench.workflow.script_job import forked
+
+# in a fork of the workflow's script server, its imports made, when one answers
+forked(snakemake, __file__)  # noqa: F821
+
 import logging
 from pathlib import Path
 

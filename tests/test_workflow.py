@@ -891,3 +891,29 @@ def test_a_parts_job_forked_from_its_server_writes_what_it_writes_alone(runs, tm
     for p in recordings:
         assert content(p) == content(tmp_path / "rerun" / p.name), p.name
 
+
+def test_a_script_forked_from_its_server_writes_what_it_writes_alone(runs, overlay, tmp_path):
+    """The run's scripts forked from the script server (the local run, of many script
+    jobs); the deadline's and the tables' scripts, each forced again alone in a copy of
+    the run (one script job: a process of its own, as a cluster runs it), write the same
+    files byte for byte."""
+    work = tmp_path / "run"
+    shutil.copytree(runs[0], work, symlinks=True)
+    server_log = work / "results/logs/script_server.log"
+    forked = server_log.read_text()
+    for rule in ("deadline", "tables"):
+        assert f"{rule}.py: forked" in forked
+    server_log.unlink()
+    start = {p: p.stat().st_mtime_ns for p in (work / "results").rglob("*") if p.is_file()}
+    for rule, target in (("deadline", "results/tables/deadline.csv"),
+                         ("tables", "results/tables/summary.csv")):
+        run_workflow(work, None, "--configfile", str(REPO / "config/config.yaml"),
+                     str(overlay), "--forcerun", rule, target=target)
+    assert not server_log.exists()
+    written = sorted(p.relative_to(work) for p in (work / "results").rglob("*")
+                     if p.is_file() and p.stat().st_mtime_ns != start.get(p)
+                     and not {"logs", "benchmarks"} & set(p.relative_to(work).parts))
+    assert {"results/figures/deadline.png", "results/tables/comparison.csv"} <= {
+        str(p) for p in written}
+    for rel in written:
+        assert (work / rel).read_bytes() == (runs[0] / rel).read_bytes(), rel
