@@ -2,6 +2,7 @@ import hashlib
 import socket
 import sys
 import tempfile
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
@@ -67,8 +68,8 @@ def pytest_collection_modifyitems(items):
     for item in items:
         if "[config:" in item.nodeid:
             item.add_marker(pytest.mark.slow)
-    # the SLURM run's tests last: their worker makes the reference runs first, which the
-    # other worker's tests of a damaged corpus compare with (tests/scheduling.py)
+    # the SLURM run's tests last: their worker makes the damaged corpus's run first,
+    # while the other makes the reference runs they compare with (tests/scheduling.py)
     items.sort(key=lambda item: "slurm_run" in getattr(item, "fixturenames", ()))
 
 
@@ -152,16 +153,18 @@ def slurm_run(overlay, tmp_path_factory):
 def runs(overlay, tmp_path_factory):
     """Two runs of the README's first command, each downloading the archive: the
     reference that the workflow tests read and that other ways of running it match,
-    and a second that must give its results byte for byte. Made once per session, by
-    the first worker that asks (workflow_runs.made_once)."""
+    and a second, made at the same time, that must give its results byte for byte.
+    Made once per session, by the first worker that asks (workflow_runs.made_once)."""
+    def run(i):
+        d = Path(tempfile.mkdtemp(prefix=f"run{i}", dir=overlay.parent))
+        run_workflow(d, None, "--configfile", str(REPO / "config/config.yaml"), str(overlay))
+        log = (d / "results/logs/download_alfa.log").read_text()
+        assert "downloading processed.zip" in log and "verified processed.zip" in log
+        return str(d)
+
     def make():
-        dirs = [Path(tempfile.mkdtemp(prefix=f"run{i}", dir=overlay.parent))
-                for i in range(2)]
-        for d in dirs:
-            run_workflow(d, None, "--configfile", str(REPO / "config/config.yaml"),
-                         str(overlay))
-            log = (d / "results/logs/download_alfa.log").read_text()
-            assert "downloading processed.zip" in log and "verified processed.zip" in log
-        return [str(d) for d in dirs]
+        # at once: each run leaves a core idle much of its time
+        with ThreadPoolExecutor(2) as pool:
+            return list(pool.map(run, range(2)))
 
     return [Path(d) for d in made_once(tmp_path_factory, "runs", make)]

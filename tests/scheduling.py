@@ -1,17 +1,18 @@
 """How pytest-xdist shares the suite between its workers (`-n 2`, pyproject.toml).
 
 The session's workflow runs cost minutes each. Two units go first, one to each worker:
-the tests of conftest.py's runs (``runs``, the reference; ``slurm_run``, which compares
-with it; ``overlay``), and the tests of the files' own runs (a file's fixture that takes
-``overlay`` makes a run of its own), each unit with the tests sharing a fixture of its
-file with them; so both workers make runs from the start, each run once. A test of the
-second unit that compares with ``runs`` reads the reference runs of the first worker
-(conftest.py makes them once per session, whichever worker asks first, and the other
-waits for them; it orders the SLURM run's tests last, so they are made first). The rest
-go file by file (a module's fixtures stay on one worker) to whichever worker is free.
-xdist's own ``loadgroup`` would group by mark, but xdist 3.8 renames the items for it
-through an attribute pytest 9 no longer reads; the controller sees test ids only, so the
-tests are found here, in each file's source, by the parameters of its functions.
+the tests of the reference runs (conftest.py's ``runs``; ``overlay``, the config every
+run shares), and the tests of the other runs (conftest.py's ``slurm_run``, and a file's
+fixture that takes ``overlay``, which makes a run of its own), each unit with the tests
+sharing a fixture of its file with them; so both workers make runs from the start,
+each run once. A test of the second unit that compares with ``runs`` reads the
+reference runs the first worker made (conftest.py makes them once per session,
+whichever worker asks first, and the other waits for them; it orders the SLURM run's
+tests last). The rest go file by file (a module's fixtures stay on one worker) to
+whichever worker is free. xdist's own ``loadgroup`` would group by mark, but xdist 3.8
+renames the items for it through an attribute pytest 9 no longer reads; the controller
+sees test ids only, so the tests are found here, in each file's source, by the
+parameters of its functions.
 """
 
 import ast
@@ -20,18 +21,18 @@ from pathlib import Path
 
 from xdist.scheduler import LoadScopeScheduling
 
-#: conftest.py's workflow runs, and the config every run of the session shares
-SHARED = frozenset({"runs", "overlay", "slurm_run"})
+#: the reference runs' fixtures, and the other session run's
+REFERENCE, OTHER = frozenset({"runs", "overlay"}), frozenset({"slurm_run"})
 #: the two work units
-GROUPS = ("conftest.py's workflow runs", "the files' own workflow runs")
+GROUPS = ("the reference workflow runs", "the other workflow runs")
 
 
 @cache
 def grouped(path: Path) -> dict[str, str]:
     """The test functions of a file that go to a unit of :data:`GROUPS`, with their
     unit: the tests joined by the file's own fixtures (a union-find) go together; to the
-    second unit when one of those fixtures makes its own run (it takes ``overlay``), else
-    to the first when one of them takes a fixture of :data:`SHARED`."""
+    second unit when one of them takes :data:`OTHER` or is a fixture making a run of its
+    own (it takes ``overlay``), else to the first when one takes :data:`REFERENCE`."""
     tree = ast.parse(path.read_text(), str(path))
     params = {node.name: {a.arg for a in node.args.args + node.args.kwonlyargs}
               for node in ast.walk(tree)
@@ -46,11 +47,11 @@ def grouped(path: Path) -> dict[str, str]:
     for name, args in params.items():
         for arg in args & set(params):
             parent[root(arg)] = root(name)
-    own = {root(n) for n, args in params.items()
-           if "overlay" in args and not n.startswith("test")}
-    shared = {root(n) for n, args in params.items() if args & SHARED} - own
-    return {n: GROUPS[1] if root(n) in own else GROUPS[0] for n in params
-            if n.startswith("test") and root(n) in own | shared}
+    other = {root(n) for n, args in params.items()
+             if args & OTHER or ("overlay" in args and not n.startswith("test"))}
+    reference = {root(n) for n, args in params.items() if args & REFERENCE} - other
+    return {n: GROUPS[1] if root(n) in other else GROUPS[0] for n in params
+            if n.startswith("test") and root(n) in other | reference}
 
 
 class SharedRunsScheduling(LoadScopeScheduling):
