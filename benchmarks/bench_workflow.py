@@ -10,7 +10,11 @@
   false-alarm probability swept), over the flights once.
 - ``--changed``: the run over the flights once, then ``glrt_arx_chi2``'s false-alarm
   probability halved and ``snakemake all`` again: the re-run's wall time and the jobs it
-  ran, per rule; and the size of the first run's ``results/``, by folder.
+  ran, per rule; and the size of the first run's ``results/``, by folder. With
+  ``--changes N``, halved N times, each time run again; with ``--against DIR``, the
+  same on the workflow of another checkout (as ``--root``), each change run on both in
+  turns, the order swapped each time: before and after on the same stretch of the
+  machine.
 - ``--extra N``: every corpus also holds N more copies (every sixth flight, recorded
   three hours later on its date): ``--extra 7`` makes the 40 local flights a corpus of
   ALFA's 47.
@@ -148,6 +152,10 @@ def main() -> None:
     ap.add_argument("--stored", action="store_true",
                     help="run again with results/ removed but for the fits kept")
     ap.add_argument("--costs", type=Path, help="only print the cost table of this run")
+    ap.add_argument("--changes", type=int, default=1,
+                    help="with --changed: how many times to change the run")
+    ap.add_argument("--against", type=Path,
+                    help="with --changed: another checkout, run in turns with --root's")
     args = ap.parse_args()
     if args.costs:
         print(cost_table(args.costs))
@@ -186,26 +194,32 @@ def main() -> None:
             print(f"| glrt_arx settings x{k} | {found} | {len(swept['methods'])} | {wall:.1f} |",
                   flush=True)
         if args.changed:
+            roots = [root, *([args.against.resolve()] if args.against else [])]
             config = tmp / "changed.yaml"
             config.write_text(yaml.safe_dump(base))
-            wall, _ = run(root, once, config, tmp / "changed", args.targets)
-            memory["all, from empty"] = job_stats(tmp / "changed")
-            costs["all, from empty"] = cost_table(tmp / "changed")
-            print(f"| all, before the change | {found} | {len(base['methods'])} | {wall:.1f} |")
+            for i, r in enumerate(roots):
+                wall, _ = run(r, once, config, tmp / f"changed{i}", args.targets)
+                print(f"| all, before the change ({r}) | {found} | {len(base['methods'])} | "
+                      f"{wall:.1f} |", flush=True)
+            memory["all, from empty"] = job_stats(tmp / "changed0")
+            costs["all, from empty"] = cost_table(tmp / "changed0")
             size = {}
-            for f in (tmp / "changed/results").rglob("*"):
+            for f in (tmp / "changed0/results").rglob("*"):
                 if f.is_file() and not f.is_symlink():
-                    part = f.relative_to(tmp / "changed/results").parts[0]
+                    part = f.relative_to(tmp / "changed0/results").parts[0]
                     size[part] = size.get(part, 0) + f.stat().st_size
             sizes = f"results/ {sum(size.values()) / 1e6:.0f} MB: " + ", ".join(
                 f"{p} {b / 1e6:.0f}" for p, b in sorted(size.items(), key=lambda x: -x[1]))
             changed = copy.deepcopy(base)
-            changed["methods"]["glrt_arx_chi2"]["params"]["false_alarm"] /= 2
-            config.write_text(yaml.safe_dump(changed))
-            wall, jobs = run(root, once, config, tmp / "changed", args.targets)
-            ran = ", ".join(f"{rule} {k}" for rule, k in sorted(jobs.items()))
-            print(f"| all, after glrt_arx_chi2 changed ({ran}) | {found} | "
-                  f"{len(base['methods'])} | {wall:.1f} |", flush=True)
+            for turn in range(args.changes):
+                changed["methods"]["glrt_arx_chi2"]["params"]["false_alarm"] /= 2
+                config.write_text(yaml.safe_dump(changed))
+                order = list(enumerate(roots))[::1 - 2 * (turn % 2)]
+                for i, r in order:
+                    wall, jobs = run(r, once, config, tmp / f"changed{i}", args.targets)
+                    ran = ", ".join(f"{rule} {k}" for rule, k in sorted(jobs.items()))
+                    print(f"| all, after glrt_arx_chi2 changed, turn {turn + 1} ({r}; {ran}) "
+                          f"| {found} | {len(base['methods'])} | {wall:.1f} |", flush=True)
         if args.stored:
             config = tmp / "stored.yaml"
             config.write_text(yaml.safe_dump(base))
