@@ -192,9 +192,14 @@ PARTS_JOB = (f"{shlex.quote(sys.executable)} -m alfa_bench.workflow.parts_job "
 # (workflow/forkserver.py); a cluster's jobs run each in its own process. One detect job
 # alone (one run changed) runs in its own process too: the server loads every run's
 # imports, and it ended about a second later than the job on its own (BENCHMARKS.md);
-# so does one script job alone
+# so does one script job alone.
+# A local run takes no rate limit: Snakemake's default one (100 jobs a second) makes each
+# pass of its scheduler start a 1 s timer for another pass, and each job's start and end
+# one more such chain, so that by the end of a run it selects jobs (and stats their
+# inputs) hundreds of times a second (docs/speed.md)
 onstart:
     if workflow.local_exec:
+        workflow.scheduler.job_rate_limiter = None
         needed = [j.rule for j in workflow.dag.needrun_jobs()]
         if sum(r.name in ("detect", "detect_reference") for r in needed) > 1:
             forkserver.start(SERVER_ENV, "alfa_bench.workflow.detect_job:server_jobs",

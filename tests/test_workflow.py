@@ -5,6 +5,7 @@ import os
 import re
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -629,6 +630,16 @@ def test_a_processed_folder_without_a_flight_that_reads_ends_on_what_to_do(tmp_p
     assert last[1] == "Details: results/logs/manifest.log", last
     assert f"ALFA_DIR is {tmp_path / 'alfa'}: no flight under its processed/ can be read" in (
         done.stderr)
+
+
+def test_a_local_run_selects_its_jobs_without_a_rate_limit(corpus, tmp_path):
+    """Snakemake's default rate limit re-runs its job selection from a timer that each
+    pass and each job event start anew (rules/common.smk's onstart): a local run sets
+    it aside, so that the jobs a selection may start are never counted down from it."""
+    done = run_workflow(tmp_path, corpus.parent, "--verbose", target="results/flights.csv",
+                        quiet=False)
+    counts = re.findall(r"Resources after job selection: .*'_job_count': (\d+)", done.stderr)
+    assert counts and set(counts) == {str(sys.maxsize)}, counts
 
 
 def test_a_misspelt_config_key_ends_on_the_key_and_the_keys_allowed(corpus, tmp_path):
