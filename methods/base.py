@@ -362,6 +362,13 @@ class Detector(ABC):
         to do. The workflow's dry run calls it for every configured run, so that a run
         fails there, not in its job. Nothing to resolve by default."""
 
+    def warm(self) -> None:  # noqa: B027 (a hook: most detectors have nothing to warm)
+        """Do once, in a process that forks jobs (the workflow's fork server), what the
+        first fit of every process would do again: a library's just-in-time compilation.
+        It learns nothing (the detector stays as it was built) and moves no random
+        state, so a job forked after it computes what it computes alone. Nothing by
+        default."""
+
     @abstractmethod
     def signals(self) -> tuple[str, ...]:
         """Names (see :data:`alfa_bench.data.SIGNALS`) of the input columns."""

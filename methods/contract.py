@@ -197,6 +197,9 @@ def check_constructor_stores_hyper_parameters_only(detector: Detector) -> None:
             f"__init__ to store its parameters {sorted(d.get_params())} and nothing else",
             f"attributes {sorted(vars(d))}")
     before = set(vars(d))
+    d.warm()
+    _expect(set(vars(d)) == before, "warm() to set nothing on the detector",
+            f"attributes {sorted(set(vars(d)) - before)}")
     _fit(d).reset()
     learned = set(vars(d)) - before
     _expect(all(a.endswith("_") for a in learned),

@@ -152,6 +152,10 @@ class NestedSelection(Detector):
 
         return make_detector(self.detector, {**(self.params or {}), **values})
 
+    def warm(self) -> None:
+        """Warm the base detector (its grid changes its values, not its library)."""
+        self._make({}).warm()
+
     def candidates(self) -> list[dict]:
         """Every combination of the grid's values, in grid order."""
         grid = self.grid or {}

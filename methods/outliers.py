@@ -428,6 +428,30 @@ class PyODDetector(OutlierModel):
             return estimator
         return estimator.fit(X)
 
+    def warm(self) -> None:
+        """Fit and score a model of this class once per process on a small fixed
+        matrix, then drop it: PyOD's HBOS compiles its scoring with numba at its first
+        fit (5 s), which the jobs forked after it then find done. NumPy's global random
+        state is put back. A model the matrix cannot fit is left cold: its job's own fit
+        says what is wrong with it."""
+        estimator = self._build()
+        kind = type(estimator).__name__
+        if kind in TRANSDUCTIVE or kind in _WARM:
+            return
+        _WARM.add(kind)
+        rows = np.arange(256.0)
+        X = np.column_stack([np.sin(rows), np.cos(0.7 * rows), np.sin(0.3 * rows) ** 2,
+                             np.cos(1.3 * rows) ** 3])
+        # a model built without a seed would draw from the global state, as jobs do
+        state = np.random.get_state()  # noqa: NPY002
+        try:
+            estimator.fit(X)
+            estimator.decision_function(X)
+        except Exception:  # the job's own fit reports it, in the job's log
+            pass
+        finally:
+            np.random.set_state(state)  # noqa: NPY002
+
     def _score(self, estimator, X):
         kind = type(estimator).__name__
         if kind in TRANSDUCTIVE:
@@ -437,6 +461,8 @@ class PyODDetector(OutlierModel):
 
 #: PyOD models whose decision_function scores a batch transductively
 TRANSDUCTIVE = ("ECOD", "COPOD")
+#: the PyOD model classes this process has warmed (PyODDetector.warm)
+_WARM: set[str] = set()
 
 
 def alone_ecdf_scores(train_sorted: np.ndarray, sums: np.ndarray, X: np.ndarray,

@@ -181,3 +181,43 @@ def test_a_model_built_from_estimator_objects_is_neither_kept_nor_changed(corpus
     d.fit(training_segments(d, flights, 1.0))
     assert not len(fits.MODEL_FITS)
     assert not any(hasattr(g, "decision_scores_") for g in given)
+
+
+class _Drawing:
+    """A model whose fit draws from NumPy's global random state, and counts its fits."""
+    fits: list = []
+
+    def fit(self, X):
+        np.random.random()  # noqa: NPY002
+        _Drawing.fits.append(X.shape)
+        return self
+
+    def decision_function(self, X):
+        return X[:, 0]
+
+
+def test_warming_fits_a_model_once_and_moves_neither_the_run_nor_the_random_state(
+        monkeypatch):
+    """The fork server warms every configured run before its jobs (Detector.warm): a
+    PyOD model is fitted and scored once per process and class, then dropped; the
+    detector is left as built and NumPy's global random state as it was, so a job
+    forked after it computes what it computes alone. A nested selection warms its base."""
+    from alfa_bench.methods import outliers
+
+    monkeypatch.setattr(outliers, "_WARM", set())
+    monkeypatch.setattr(_Drawing, "fits", [])
+    d = PyODDetector(model=_Drawing())
+    built = dict(vars(d))
+    np.random.seed(3)  # noqa: NPY002
+    state = np.random.get_state()[1].copy()  # noqa: NPY002
+    d.warm()
+    d.warm()
+    PyODDetector(model=_Drawing()).warm()
+    assert len(_Drawing.fits) == 1 and vars(d) == built
+    np.testing.assert_array_equal(np.random.get_state()[1], state)  # noqa: NPY002
+
+    warmed = []
+    monkeypatch.setattr(PyODDetector, "warm", lambda self: warmed.append(self.get_params()))
+    make_detector("nested_selection", {"detector": "pyod", "params": {"model": "HBOS"},
+                                       "grid": {"window_s": [1.0, 2.0]}}).warm()
+    assert [w["model"] for w in warmed] == ["HBOS"]

@@ -96,15 +96,18 @@ def parse(argv: list[str]) -> argparse.Namespace:
 
 def preload(config: dict) -> None:
     """Import what the detect jobs of ``config`` run on: the data layer, the records,
-    each configured run's detector module and library model (PyOD's, river's), and
-    the figure panels. The fork server calls it once; its jobs start from here."""
+    each configured run's detector module and library model (PyOD's, river's), warmed
+    (:meth:`~alfa_bench.methods.base.Detector.warm`), and the figure panels. The fork
+    server calls it once; its jobs start from here."""
     from alfa_bench.data.inject import InjectedGrid  # noqa: F401
     from alfa_bench.methods import make_detector
     from alfa_bench.outputs.flight_figures import FlightPanel
     from alfa_bench.outputs.records import write_detections  # noqa: F401
 
     for spec in config["methods"].values():
-        make_detector(spec["detector"], spec.get("params")).check_params()
+        detector = make_detector(spec["detector"], spec.get("params"))
+        detector.check_params()
+        detector.warm()
     FlightPanel("")                 # matplotlib's fonts and text metrics, loaded
     from .forkserver import imported_sources
 
