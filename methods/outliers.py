@@ -434,11 +434,11 @@ class PyODDetector(OutlierModel):
         fit (5 s), which the jobs forked after it then find done. NumPy's global random
         state is put back. A model the matrix cannot fit is left cold: its job's own fit
         says what is wrong with it."""
-        estimator = self._build()
-        kind = type(estimator).__name__
+        kind = self._name()
         if kind in TRANSDUCTIVE or kind in _WARM:
             return
         _WARM.add(kind)
+        estimator = self._build()
         rows = np.arange(256.0)
         X = np.column_stack([np.sin(rows), np.cos(0.7 * rows), np.sin(0.3 * rows) ** 2,
                              np.cos(1.3 * rows) ** 3])
