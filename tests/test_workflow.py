@@ -866,15 +866,9 @@ def test_a_run_taken_out_of_the_config_is_named_removable_and_never_compared(run
     assert (work / "results/detections/silent").is_dir()
 
 
-def test_a_parts_job_forked_from_its_server_writes_what_it_writes_alone(runs, tmp_path):
-    """The run's parts jobs forked from the parts server (the local run); the job of a
-    run scored on the injected grid, run again in a process of its own as a cluster
-    runs it, writes the same parts byte for byte and the same recordings."""
-    from recordings import content
-
-    from alfa_bench.workflow import parts_job
-
-    work, method = runs[0], "glrt_arx"
+def _parts_job(work: Path, method: str, to: Path) -> tuple[dict, list[str]]:
+    """The parts job of ``method`` in the run ``work``, writing to ``to``: its outputs
+    (by table, relative to ``to``) and its command's arguments."""
     config = yaml.safe_load((REPO / "config/config.yaml").read_text())
     primary = config["primary_subset"]
     out = {"sweep": "sweep/m.csv", "per_flight": "per_flight/m.jsonl",
@@ -884,13 +878,25 @@ def test_a_parts_job_forked_from_its_server_writes_what_it_writes_alone(runs, tm
     argv = [method, "--manifest", str(work / "results/flights.csv"),
             "--detections", str(work / f"results/detections/{method}"),
             "--traces", str(work / f"results/traces/{method}"),
-            "--recordings", str(tmp_path / "rerun"), "--log", str(tmp_path / "log"),
+            "--recordings", str(to / "rerun"), "--log", str(to / "log"),
             "--subsets", json.dumps([primary, *(s for s in config["subsets"] if s != primary)]),
             "--deadline-s", str(config["scoring"]["deadline_s"]),
             "--injected-manifest", str(work / "results/injected/flights.csv"),
             "--injected", str(work / f"results/injected/detections/{method}"),
-            *(a for k, v in out.items() for a in (f"--{k.replace('_', '-')}",
-                                                  str(tmp_path / v)))]
+            *(a for k, v in out.items() for a in (f"--{k.replace('_', '-')}", str(to / v)))]
+    return out, argv
+
+
+def test_a_parts_job_forked_from_its_server_writes_what_it_writes_alone(runs, tmp_path):
+    """The run's parts jobs forked from the parts server (the local run); the job of a
+    run scored on the injected grid, run again in a process of its own as a cluster
+    runs it, writes the same parts byte for byte and the same recordings."""
+    from recordings import content
+
+    from alfa_bench.workflow import parts_job
+
+    work, method = runs[0], "glrt_arx"
+    out, argv = _parts_job(work, method, tmp_path)
     os.environ.pop(parts_job.SERVER_ENV, None)
     assert parts_job.main(argv) == 0
     for table, path in out.items():
@@ -901,6 +907,27 @@ def test_a_parts_job_forked_from_its_server_writes_what_it_writes_alone(runs, tm
         p.name for p in (tmp_path / "rerun").glob("*.rrd"))
     for p in recordings:
         assert content(p) == content(tmp_path / "rerun" / p.name), p.name
+
+
+def test_a_parts_job_imports_no_scipy_module_its_server_did_not_preload(runs, tmp_path):
+    """Every parts job is a fork of the parts server: a module it first imports in the
+    fork (scipy.special for the sweep's intervals took a quarter of a second) is paid
+    by each job of every run, where the server's preload pays it once."""
+    from alfa_bench.workflow import parts_job
+
+    _, argv = _parts_job(runs[0], "glrt_arx", tmp_path)
+    code = ("import json, sys\n"
+            "from alfa_bench.workflow import parts_job\n"
+            "parts_job.preload()\n"
+            "before = set(sys.modules)\n"
+            "assert parts_job.main(json.loads(sys.argv[1])) == 0\n"
+            "print(json.dumps(sorted(set(sys.modules) - before)))\n")
+    env = {k: v for k, v in os.environ.items() if k != parts_job.SERVER_ENV}
+    done = subprocess.run([sys.executable, "-c", code, json.dumps(argv)], env=env,
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    late = json.loads(done.stdout.splitlines()[-1])
+    assert not [m for m in late if m.split(".")[0] == "scipy"], late
 
 
 def test_a_script_forked_from_its_server_writes_what_it_writes_alone(runs, overlay, tmp_path):

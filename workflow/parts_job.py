@@ -58,6 +58,10 @@ def parse(argv: list[str]) -> argparse.Namespace:
 def preload() -> None:
     """Import what the parts jobs run on. The server calls it once; its jobs start
     from here."""
+    # scipy.special: the sweep's intervals (analysis.scoring.wilson_interval) import it
+    # where they are computed, which in a fork cost each job a quarter of a second
+    import scipy.special  # noqa: F401
+
     from alfa_bench.analysis import detectability, isolation, per_flight, sweep  # noqa: F401
     from alfa_bench.outputs import parquet, parts, records, rerun_log, traces  # noqa: F401
 
