@@ -15,18 +15,12 @@ figures, recordings, provenance, the paper) and :mod:`alfa_bench.workflow` (what
 the Snakemake rules and scripts use).
 """
 
-from importlib.metadata import PackageNotFoundError, version
-
 from alfa_bench.lazy import lazy_names
-
-try:
-    __version__ = version("alfa-bench")
-except PackageNotFoundError:   # run from sources that were never installed
-    __version__ = "0+unknown"
 
 # each name's module, imported when the name is first used: a workflow job that imports
 # one module of the package pays for no other
 _MODULES = {
+    "__version__": "alfa_bench.version",
     **dict.fromkeys(["Corpus", "Result", "compare", "evaluate", "load_corpus", "user_cache"],
                     "alfa_bench.evaluation"),
     **dict.fromkeys(["ConfigError", "load_config"], "alfa_bench.config"),
@@ -35,5 +29,5 @@ _MODULES = {
                      "make_detector"], "alfa_bench.methods"),
 }
 
-__all__ = ["__version__", *sorted(_MODULES)]
+__all__ = sorted(_MODULES)
 __getattr__, __dir__ = lazy_names(__name__, _MODULES)
