@@ -198,6 +198,7 @@ def test_a_model_reading_the_emulation_is_refused_for_a_link_unless_allowed():
     assert Monitor(det.fit([]), allow_actuators=True).names == tuple(det.signals())
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not os.environ.get("ALFA_DIR"), reason="real ALFA flights: set ALFA_DIR")
 def test_on_real_flights_a_replayed_log_gives_the_workflows_first_alarm(tmp_path):
     """The first flight of each date (every local flight with ALFA_LIVE_ALL=1: about 6

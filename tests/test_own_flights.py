@@ -13,6 +13,9 @@ import pytest
 from unavailable import require_module, unavailable
 from workflow_runs import REPO, run_workflow
 
+# the workflow in a subprocess, to the tables and the page
+pytestmark = pytest.mark.workflow
+
 PX4 = Path(__file__).resolve().parents[2] / "shared" / "logs" / "px4"
 
 
