@@ -9,13 +9,18 @@ each run once. A test of the second unit that compares with ``runs`` reads the
 reference runs the first worker made (conftest.py makes them once per session,
 whichever worker asks first, and the other waits for them; it orders the SLURM run's
 tests last). The rest go file by file (a module's fixtures stay on one worker) to
-whichever worker is free. xdist's own ``loadgroup`` would group by mark, but xdist 3.8
+whichever worker is free, first those of a file that marks a test ``workflow`` or
+``slow`` (a subprocess, a browser: seconds to a minute each; :func:`marked`), then
+the others, each kind with the most tests first: a heavy file handed out last kept one
+worker busy for a minute and a half after the other had ended. xdist's own
+``loadgroup`` would group by mark, but xdist 3.8
 renames the items for it through an attribute pytest 9 no longer reads; the controller
 sees test ids only, so the tests are found here, in each file's source, by the
 parameters of its functions. The contract's checks go by detector (:data:`BY_DETECTOR`).
 """
 
 import ast
+from collections import OrderedDict
 from functools import cache
 from pathlib import Path
 
@@ -58,13 +63,31 @@ def grouped(path: Path) -> dict[str, str]:
             if n.startswith("test") and root(n) in other | reference}
 
 
+#: the marks of tests that take seconds or more each (pyproject.toml's markers)
+HEAVY = frozenset({"workflow", "slow"})
+
+
+@cache
+def marked(path: Path) -> bool:
+    """Whether the file marks any test :data:`HEAVY`: its ``pytestmark``, or a test
+    function's ``@pytest.mark.<name>``."""
+    tree = ast.parse(path.read_text(), str(path))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Attribute) and node.attr in HEAVY and isinstance(
+                node.value, ast.Attribute) and node.value.attr == "mark":
+            return True
+    return False
+
+
 class SharedRunsScheduling(LoadScopeScheduling):
     """Load by file, but the tests of :func:`grouped` in their two units, handed out
-    first (module docstring); then the files with the most tests first."""
+    first (module docstring); then the units of :func:`marked` files, then the rest,
+    each with the most tests first."""
 
     def __init__(self, config, log=None):
         super().__init__(config, log)
         self.rootpath = Path(config.rootpath)
+        self.ordered = False
 
     def _split_scope(self, nodeid: str) -> str:
         file, _, rest = nodeid.partition("::")
@@ -74,8 +97,16 @@ class SharedRunsScheduling(LoadScopeScheduling):
             return f"{file}::{case.rsplit('-', 1)[0]}"
         return grouped(path).get(test, file) if path.suffix == ".py" else file
 
+    def _rank(self, scope: str) -> int:
+        if scope in GROUPS:
+            return GROUPS.index(scope)
+        path = self.rootpath / scope.partition("::")[0]
+        return len(GROUPS) + (0 if path.suffix == ".py" and marked(path) else 1)
+
     def _assign_work_unit(self, node) -> None:
-        for group in reversed(GROUPS):
-            if group in self.workqueue:
-                self.workqueue.move_to_end(group, last=False)
+        if not self.ordered:    # xdist queued them by their number of tests: kept within a rank
+            self.workqueue = OrderedDict(
+                (scope, self.workqueue[scope]) for scope in sorted(self.workqueue,
+                                                                   key=self._rank))
+            self.ordered = True
         super()._assign_work_unit(node)
