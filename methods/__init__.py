@@ -10,7 +10,6 @@ test covers it (``examples/alfa-cusum``).
 """
 
 import importlib
-import inspect
 from importlib.metadata import entry_points
 
 from .base import (
@@ -30,6 +29,7 @@ from .base import (
     fit_token,
     fork_for,
     forks,
+    init_parameters,
     labelled_segments,
     run_detector,
     source_digest,
@@ -143,7 +143,7 @@ def make_detector(name: str, params: dict | None = None) -> Detector:
             raise KeyError(f"unknown detector {name!r}; registered: "
                            f"{sorted(registry)}") from None
     params = dict(params or {})
-    signature = inspect.signature(cls.__init__).parameters
+    signature = init_parameters(cls)
     for key, value in params.items():
         if key not in signature or key == "self":
             raise TypeError(f"detector {name!r} has no parameter {key!r}; it has "

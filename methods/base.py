@@ -205,6 +205,14 @@ def json_ready(value):
 
 
 @functools.cache
+def init_parameters(cls: type) -> types.MappingProxyType:
+    """``cls.__init__``'s parameters by name, read once per class: every detector built
+    reads them, and a nested selection builds its base each time it is asked its
+    layout."""
+    return inspect.signature(cls.__init__).parameters
+
+
+@functools.cache
 def source_digest(cls: type, package: bool = False) -> str:
     """A digest of the code of ``cls`` and of its bases outside alfa-bench (with
     ``package``, alfa-bench's own too): the source where it can be read, else its
@@ -349,7 +357,7 @@ class Detector(ABC):
         """The hyper-parameters' names: those of ``__init__`` (none without one)."""
         if cls.__init__ is object.__init__:
             return []
-        return [n for n, p in inspect.signature(cls.__init__).parameters.items()
+        return [n for n, p in init_parameters(cls).items()
                 if n != "self" and p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)]
 
     def get_params(self) -> dict:

@@ -23,13 +23,19 @@ def skipped_channels(detector, dead) -> dict[str, str]:
     """Channels of ``detector`` to skip when the signals ``dead`` are not measured: a
     channel scoring a dead output, and every channel when a dead signal is an input
     (no model is driven by a signal that is not there)."""
-    dead = [d for d in detector.signals() if d in set(dead)]
+    return _skipped(detector.signals(), detector.channel_outputs(), detector.channels(),
+                    dead)
+
+
+def _skipped(signals, outputs, channels, dead) -> dict[str, str]:
+    # a detector's layout read once by the caller: a nested selection builds its base
+    # detector each time it is asked
+    dead = [d for d in signals if d in set(dead)]
     if not dead:
         return {}
-    outputs = detector.channel_outputs()
     inputs = [d for d in dead if d not in outputs]
     return {ch: (f"input {inputs[0]} not measured" if inputs else f"{out} not measured")
-            for ch, out in zip(detector.channels(), outputs, strict=True)
+            for ch, out in zip(channels, outputs, strict=True)
             if inputs or out in dead}
 
 
@@ -47,15 +53,14 @@ class UnmovedSensors:
     """
 
     def __init__(self, detector):
-        self.detector = detector
-        names = detector.signals()
+        self.layout = (detector.signals(), detector.channel_outputs(), detector.channels())
+        names, _, channels = self.layout
         self.sensors = [j for j, n in enumerate(names) if SIGNALS[n].kind == "sensor"]
         self.names = [names[j] for j in self.sensors]
-        channels = detector.channels()
         # sensor i leaves channel c unscored while it has not moved
         self.blocks = np.zeros((len(self.sensors), len(channels)), dtype=bool)
         for i, name in enumerate(self.names):
-            for ch in skipped_channels(detector, [name]):
+            for ch in _skipped(*self.layout, [name]):
                 self.blocks[i, channels.index(ch)] = True
         self.first_: np.ndarray | None = None
         self.moved_ = np.zeros(len(self.sensors), dtype=bool)
@@ -79,4 +84,4 @@ class UnmovedSensors:
     def skipped(self) -> dict[str, str]:
         """The channels left unscored at the last step fed, and why
         (:func:`skipped_channels` of :meth:`unmoved`)."""
-        return skipped_channels(self.detector, self.unmoved())
+        return _skipped(*self.layout, self.unmoved())

@@ -3,6 +3,7 @@ never alarmed on and never injected into; a constant command is not missing data
 channels are not scored until it moves, a causal rule the batch run and the live monitor
 share."""
 
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +14,13 @@ from alfa_bench.data.inject import inject_grid, inject_sensor_fault
 from alfa_bench.data.synthetic import write_flight
 from alfa_bench.live import replay
 from alfa_bench.live.monitor import Monitor
-from alfa_bench.methods import fault_free_segments, make_detector, run_detector
+from alfa_bench.methods import (
+    UnmovedSensors,
+    fault_free_segments,
+    make_detector,
+    run_detector,
+    skipped_channels,
+)
 
 FREE = "carbonZ_2018-09-11-14-16-55_no_failure"
 BANK = {"inputs": ["roll_cmd", "pitch_cmd"], "outputs": ["roll", "airspeed"]}
@@ -95,6 +102,31 @@ def test_a_dead_input_skips_every_channel(dead_airspeed, corpus):
     detector.fit(fault_free_segments(detector, [load_flight(p) for p in corpus.iterdir()], 1.0))
     trace = run_detector(detector, load_flight(dead_airspeed))
     assert set(trace.skipped) == {"roll", "pitch"} and not trace.alarm.any()
+
+
+def test_the_rule_reads_a_detectors_layout_once_however_many_sensors(monkeypatch):
+    """A nested selection builds its base detector each time it is asked its signals,
+    outputs or channels, and every flight of every fit's calibration starts the rule:
+    it asks each once, and says what skipped_channels says."""
+    detector = make_detector("nested_selection", {
+        "detector": "kalman_okid", "params": BANK, "grid": {"false_alarm": [0.05, 0.1]}})
+    signals = detector.signals()
+    dead = [n for n in signals if n in ("roll", "airspeed")]
+    expected = skipped_channels(detector, dead)
+    asked = Counter()
+
+    def counted(name):
+        method = getattr(detector, name)
+        return lambda: (asked.update([name]), method())[1]
+
+    for name in ("signals", "channel_outputs", "channels"):
+        monkeypatch.setattr(detector, name, counted(name))
+    unmoved = UnmovedSensors(detector)
+    x = np.ones((4, len(signals)))
+    x[1:, [i for i, n in enumerate(signals) if n not in dead]] += 1.0   # commands move
+    unmoved.blanked(x)
+    assert len(unmoved.names) == 2 and unmoved.skipped() == expected and expected
+    assert asked == {"signals": 1, "channel_outputs": 1, "channels": 1}
 
 
 def test_calibration_leaves_the_flight_out(dead_airspeed):
