@@ -8,7 +8,7 @@ from config_runs import CONFIG
 
 from alfa_bench.data import Sampled
 from alfa_bench.data.flight import parse_flight_name
-from alfa_bench.methods import base, fits, labelled_segments, make_detector, physics
+from alfa_bench.methods import base, bench_logistic, fits, labelled_segments, make_detector, physics
 from alfa_bench.methods.bench_logistic import BenchLogistic
 from alfa_bench.methods.nested_selection import INNER_FITS
 
@@ -71,6 +71,34 @@ def test_a_kept_classifier_fit_is_the_fresh_fit(corpus_flights):
     moved[faulty] = base.Labelled(segments[faulty].sampled, segments[faulty].onset_s + 1.0,
                                   segments[faulty].fault_class)
     assert base.segment_digest(moved[faulty]) != base.segment_digest(segments[faulty])
+
+
+def test_a_segments_physics_block_is_computed_once_and_is_what_it_computes(monkeypatch):
+    """The physics block is fitted on nothing: the candidates and folds of a nested
+    selection read one computation of it per segment and first step, the same as a fresh
+    one, and cannot write into it; a new segment of the same values is computed anew."""
+    n = 400
+    rng = np.random.default_rng(1)
+    x = rng.normal(size=(n, len(physics.SIGNALS_READ)))
+
+    def segment():
+        return Sampled(t=np.arange(n) / physics.RATE_HZ, x=x.copy(),
+                       fresh=np.ones_like(x, bool), names=physics.SIGNALS_READ)
+
+    s = segment()
+    fresh = physics.features_of(s.columns(physics.SIGNALS_READ))
+    expected = np.nan_to_num(np.column_stack([fresh[f] for f in physics.FEATURES]), nan=0.0)
+    made = []
+    real = physics.features_of
+    monkeypatch.setattr(physics, "features_of", lambda *a: made.append(a) or real(*a))
+    one, two = (bench_logistic._physics_block(s, 0) for _ in range(2))
+    assert len(made) == 1 and one is two and np.array_equal(one, expected)
+    with pytest.raises(ValueError, match="read-only"):
+        one[0, 0] = 1.0
+    bench_logistic._physics_block(s, 5)
+    other = segment()
+    assert np.array_equal(bench_logistic._physics_block(other, 0), expected)
+    assert len(made) == 3
 
 
 @pytest.mark.parametrize("features", [("bank",), ("study", "study"), ("study", "wind")])
