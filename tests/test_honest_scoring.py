@@ -301,3 +301,22 @@ def test_a_run_no_better_than_silence_is_flagged(corpus_manifest):
     assert table.loc["silent", "beats_silence"] is None
     text = comparison_markdown(table.reset_index())
     assert "quiet (no better than silence)" in text and "timely (no" not in text
+
+
+def test_the_by_fault_tables_flight_times_sum_as_pandas_sums_a_column():
+    """The per-fault table sums flight and pre-fault times from dictionaries, not a
+    frame's rows: the same float, bit for bit, NaN (a fault-free flight's pre-fault
+    time) counted as 0."""
+    import numpy as np
+    import pandas as pd
+
+    from alfa_bench.outputs.tables import _total
+
+    # a draw whose sum in Python's order and math.fsum's both differ from pandas's
+    rng = np.random.default_rng(13)
+    values = rng.uniform(0, 400, size=40) * 10.0 ** rng.integers(-3, 3, size=40)
+    values[::7] = np.nan
+    frame = pd.Series(values, index=[f"f{i}" for i in range(40)])
+    flights = [f"f{i}" for i in rng.permutation(40)[:23]]
+    assert _total(frame.to_dict(), flights) == float(frame.loc[flights].sum())
+    assert _total(frame.to_dict(), ["f0"]) == 0.0
