@@ -850,7 +850,8 @@ def segment_digest(s: Sampled | Labelled) -> bytes:
         label = (s.onset_s, s.fault_class, s.emergency_trajectory)
         return hashlib.sha256(segment_digest(s.sampled) + repr(label).encode()).digest()[:16]
     # SHA-256, not BLAKE2: a nested selection digests its training data for each fit it
-    # asks for, and SHA-256 runs on the CPU's own instructions (2.9 times as fast here)
+    # asks for, and SHA-256 runs on the CPU's own instructions (2.9 times as fast on
+    # the machine of BENCHMARKS.md)
     h = hashlib.sha256(s.flight.encode())
     for a in (s.t, s.x, s.fresh):
         h.update(np.ascontiguousarray(a).data)

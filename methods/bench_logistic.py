@@ -193,7 +193,8 @@ _PHYSICS: dict[int, tuple[weakref.ref, int, np.ndarray]] = {}
 def _physics_block(s: Sampled, first_step: int) -> np.ndarray:
     """The physics block of ``s``, computed once per segment: it is fitted on nothing, so
     that every candidate and fold of a nested selection reads the same block of the same
-    segment (a tenth of its job when computed for each). Read-only, like ``s``."""
+    segment (a tenth of its job when computed for each). Read-only: every caller shares
+    it."""
     kept = _PHYSICS.get(id(s))
     if kept is not None and kept[0]() is s and kept[1] == first_step:
         return kept[2]

@@ -225,10 +225,8 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
     takes over the pools (the other ranked runs re-scored under the same pools)."""
     kept, left_out = common_ground(records, manifest, failures)
     ground = _on_ground(records, manifest, subsets, failures)
-    table = stability_table(kept, manifest, subsets, deadline_s, stable, interval)
-    keys = list(zip(table["subset"], table["method"], strict=True))
-    pooled = {k: dict(zip(keys, table[k], strict=True))
-              for k in ("stable_detections", "detections_low", "detections_high")}
+    pooled = {(row["subset"], row["method"]): row for row in stability_table(
+        kept, manifest, subsets, deadline_s, stable, interval).to_dict("records")}
     own = _failures(failures)
     own = own[own["method"] != ""]
     rows = []
@@ -253,7 +251,7 @@ def comparison_table(records: list[dict], manifest: pd.DataFrame, subsets, deadl
                 "isolation": named / hits if hits else math.nan,
                 "excluded": excluded,
                 "failed_flights": failed,
-                **{k: pooled[k][(subset, method)]
+                **{k: pooled[(subset, method)][k]
                    for k in ("stable_detections", "detections_low", "detections_high")},
             }, recs))
         honest = sorted((r[:2] for r in runs if r[1]["block"] == "honest"),

@@ -3,6 +3,8 @@
 import io
 import math
 
+import numpy as np
+import pandas as pd
 import pytest
 from scipy.stats import binomtest
 
@@ -15,7 +17,7 @@ from alfa_bench.analysis.scoring import (
     wilson_interval,
 )
 from alfa_bench.data import read_manifest
-from alfa_bench.outputs.tables import comparison_table
+from alfa_bench.outputs.tables import _total, comparison_table
 
 
 def test_a_first_alarm_after_the_deadline_is_a_miss():
@@ -307,11 +309,6 @@ def test_the_by_fault_tables_flight_times_sum_as_pandas_sums_a_column():
     """The per-fault table sums flight and pre-fault times from dictionaries, not a
     frame's rows: the same float, bit for bit, NaN (a fault-free flight's pre-fault
     time) counted as 0."""
-    import numpy as np
-    import pandas as pd
-
-    from alfa_bench.outputs.tables import _total
-
     # a draw whose sum in Python's order and math.fsum's both differ from pandas's
     rng = np.random.default_rng(13)
     values = rng.uniform(0, 400, size=40) * 10.0 ** rng.integers(-3, 3, size=40)
